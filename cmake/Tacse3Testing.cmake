@@ -1,0 +1,26 @@
+# SPDX-License-Identifier: Apache-2.0
+# GoogleTest is compiled from source with the project's own compiler and flags, so the same
+# recipe serves the host, the sanitizer build and the cross builds run under qemu-user.
+macro(tacse3_enable_gtest)
+  if(NOT TARGET gtest_main)
+    set(INSTALL_GTEST OFF CACHE BOOL "" FORCE)
+    set(BUILD_GMOCK OFF CACHE BOOL "" FORCE)
+    add_subdirectory("${TACSE3_GTEST_SOURCE_DIR}" "${CMAKE_BINARY_DIR}/_googletest" EXCLUDE_FROM_ALL SYSTEM)
+  endif()
+  include(GoogleTest)
+endmacro()
+
+# tacse3_add_gtest(<name> SOURCES <files...> LIBS <targets...> [LABELS <labels...>] [TIMEOUT s])
+# One executable per test file; tests are discovered at ctest time (PRE_TEST) so discovery
+# also works through CMAKE_CROSSCOMPILING_EMULATOR.
+function(tacse3_add_gtest name)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest_main)
+  tacse3_warnings(${name})
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 600)
+  endif()
+  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 120
+                       PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}")
+endfunction()
