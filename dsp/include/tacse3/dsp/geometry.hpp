@@ -28,10 +28,18 @@ inline constexpr int kGridCount = kGridWidth * kGridHeight;    // 1200
 inline constexpr double kPadCentreX = 159.5;
 inline constexpr double kPadCentreY = 119.5;
 
-constexpr double grid_work_x(int gx) noexcept { return kGridStride * gx + 1.5; }
-constexpr double grid_work_y(int gy) noexcept { return kGridStride * gy + 1.5; }
-constexpr double grid_sensor_x(int gx) noexcept { return kWorkScale * grid_work_x(gx) + 0.5; }
-constexpr double grid_sensor_y(int gy) noexcept { return kWorkScale * grid_work_y(gy) + 0.5; }
+constexpr double grid_work_x(int gx) noexcept {
+  return kGridStride * gx + 1.5;
+}
+constexpr double grid_work_y(int gy) noexcept {
+  return kGridStride * gy + 1.5;
+}
+constexpr double grid_sensor_x(int gx) noexcept {
+  return kWorkScale * grid_work_x(gx) + 0.5;
+}
+constexpr double grid_sensor_y(int gy) noexcept {
+  return kWorkScale * grid_work_y(gy) + 0.5;
+}
 
 static_assert(kSensorWidth % (kWorkScale * kGridStride) == 0, "grid must tile the frame");
 static_assert(kSensorHeight % (kWorkScale * kGridStride) == 0, "grid must tile the frame");

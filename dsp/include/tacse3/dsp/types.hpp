@@ -14,21 +14,27 @@ namespace tacse3::dsp {
 // semantics in mind) and never aborts on bad input.
 enum class Status : std::uint8_t {
   kOk = 0,
-  kNullFrame,        // data pointer is null
-  kBadFrameSize,     // width/height/stride/byte count do not match 320x240 in the given format
-  kBadPixelFormat,   // unknown PixelFormat value
-  kBadCalibration,   // a calibration field is NaN, infinite or out of its documented range
-  kBadArgument,      // any other argument outside its documented range
+  kNullFrame,       // data pointer is null
+  kBadFrameSize,    // width/height/stride/byte count do not match 320x240 in the given format
+  kBadPixelFormat,  // unknown PixelFormat value
+  kBadCalibration,  // a calibration field is NaN, infinite or out of its documented range
+  kBadArgument,     // any other argument outside its documented range
 };
 
 constexpr const char* to_string(Status s) noexcept {
   switch (s) {
-    case Status::kOk: return "ok";
-    case Status::kNullFrame: return "null frame data";
-    case Status::kBadFrameSize: return "frame size does not match 320x240 in the given pixel format";
-    case Status::kBadPixelFormat: return "unsupported pixel format";
-    case Status::kBadCalibration: return "calibration field out of range or not finite";
-    case Status::kBadArgument: return "argument out of range";
+    case Status::kOk:
+      return "ok";
+    case Status::kNullFrame:
+      return "null frame data";
+    case Status::kBadFrameSize:
+      return "frame size does not match 320x240 in the given pixel format";
+    case Status::kBadPixelFormat:
+      return "unsupported pixel format";
+    case Status::kBadCalibration:
+      return "calibration field out of range or not finite";
+    case Status::kBadArgument:
+      return "argument out of range";
   }
   return "unknown status";
 }
@@ -42,25 +48,31 @@ enum class PixelFormat : std::uint8_t {
 // A borrowed view of one camera frame. The pipeline never keeps the pointer past the call.
 struct FrameView {
   const std::uint8_t* data = nullptr;
-  std::size_t size_bytes = 0;   // bytes available at data
+  std::size_t size_bytes = 0;  // bytes available at data
   int width = 0;
   int height = 0;
-  int stride_bytes = 0;         // bytes per row; 0 means tightly packed
+  int stride_bytes = 0;  // bytes per row; 0 means tightly packed
   PixelFormat format = PixelFormat::kGrey;
 };
 
 // Working image: luma after the 2x2 box downsample, format U8.2 (luma * 4, range 0..1020).
 struct WorkImage {
   alignas(16) std::array<std::uint16_t, kWorkPixels> px{};
-  std::uint16_t& at(int x, int y) noexcept { return px[static_cast<std::size_t>(y * kWorkWidth + x)]; }
-  std::uint16_t at(int x, int y) const noexcept { return px[static_cast<std::size_t>(y * kWorkWidth + x)]; }
+  std::uint16_t& at(int x, int y) noexcept {
+    return px[static_cast<std::size_t>(y * kWorkWidth + x)];
+  }
+  std::uint16_t at(int x, int y) const noexcept {
+    return px[static_cast<std::size_t>(y * kWorkWidth + x)];
+  }
 };
 
 // A scalar sample per flow-grid point, row-major (gy * kGridWidth + gx).
 template <typename T>
 struct GridArray {
   alignas(16) std::array<T, kGridCount> v{};
-  T& operator()(int gx, int gy) noexcept { return v[static_cast<std::size_t>(gy * kGridWidth + gx)]; }
+  T& operator()(int gx, int gy) noexcept {
+    return v[static_cast<std::size_t>(gy * kGridWidth + gx)];
+  }
   const T& operator()(int gx, int gy) const noexcept {
     return v[static_cast<std::size_t>(gy * kGridWidth + gx)];
   }

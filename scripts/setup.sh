@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# tacse3: install everything needed to build, run and test tacse3 on a fresh Debian 12 machine.
+# Usage: scripts/setup.sh   (as root, or as a user with sudo)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+APT_OPTS=(-y -o Acquire::Retries=5 -o DPkg::Lock::Timeout=600)
+export DEBIAN_FRONTEND=noninteractive
+
+PACKAGES=(
+  # toolchain and build
+  build-essential cmake ninja-build pkg-config git file clang clang-format
+  # cross builds for the Raspberry Pi targets, run under qemu-user
+  g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user-static
+  # libraries
+  libeigen3-dev googletest libgtest-dev libbenchmark-dev
+  libtomlplusplus-dev libcli11-dev libspng-dev libpng-dev nlohmann-json3-dev
+  # protocol cross-checks: python-can example and the independent DBC decoder (npm)
+  python3 python3-can nodejs npm
+)
+
+$SUDO apt-get update -o Acquire::Retries=5
+$SUDO apt-get install "${APT_OPTS[@]}" "${PACKAGES[@]}"
+
+# The independent DBC decoder used by the protocol tests (pinned by package-lock.json).
+for dir in tests/protocol/dbc; do
+  if [ -f "$dir/package-lock.json" ]; then
+    (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+done
+echo "tacse3 setup: done"

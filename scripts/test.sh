@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# tacse3: the test command. Builds and runs the host tests, the ASan+UBSan build and the aarch64
+# build under qemu-user, then the bounded protocol fuzzers. Exits non-zero on any failure.
+# Usage: scripts/test.sh [preset ...]      (default: host host-sanitize aarch64)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+JOBS="${TACSE3_JOBS:-$(nproc)}"
+presets=("$@")
+if [ ${#presets[@]} -eq 0 ]; then presets=(host host-sanitize aarch64); fi
+
+declare -a summary=()
+for preset in "${presets[@]}"; do
+  echo "=== [$preset] configure + build ==="
+  cmake --preset "$preset" >/dev/null
+  cmake --build --preset "$preset" -j "$JOBS"
+  echo "=== [$preset] ctest ==="
+  ctest --preset "$preset" -j "$JOBS"
+  summary+=("$preset: ok")
+done
+
+if [ -x fuzz/run.sh ] && [ "${TACSE3_SKIP_FUZZ:-0}" != "1" ]; then
+  echo "=== protocol fuzzers (bounded) ==="
+  fuzz/run.sh "${TACSE3_FUZZ_SECONDS:-60}"
+  summary+=("fuzz: ok")
+fi
+
+echo "=== summary ==="
+printf '%s\n' "${summary[@]}"
