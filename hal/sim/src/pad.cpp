@@ -1,0 +1,498 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 sim: per-pad contact mechanics: ray-traced contact patch, bulge, stick/slide shear,
+// spreading.
+#include "tacse3/sim/pad.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tacse3::sim {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kContactEpsMm = 1e-6;
+constexpr double kSorOmega = 1.8;
+constexpr double kSorTolMm = 1e-4;
+constexpr int kSorMaxSweeps = 200;
+
+bool finite_in(double v, double lo, double hi) {
+  return std::isfinite(v) && v >= lo && v <= hi;
+}
+
+}  // namespace
+
+std::string validate(const GelSpec& g) {
+  if (!finite_in(g.spread_length_mm, 0.1, 50.0)) return "gel spread_length_mm must be in [0.1, 50]";
+  if (!finite_in(g.bulge_gain_mm, 0.0, 20.0)) return "gel bulge_gain_mm must be in [0, 20]";
+  if (!finite_in(g.bulge_sigma_mm, 0.1, 20.0)) return "gel bulge_sigma_mm must be in [0.1, 20]";
+  if (!finite_in(g.drag_time_s, 0.0, 10.0)) return "gel drag_time_s must be in [0, 10]";
+  if (!finite_in(g.lag_time_s, 1e-4, 10.0)) return "gel lag_time_s must be in [1e-4, 10]";
+  if (!finite_in(g.shear_compliance, 0.0, 100.0)) return "gel shear_compliance must be in [0, 100]";
+  if (!finite_in(g.slip_speed_mm_s, 0.0, 1000.0)) return "gel slip_speed_mm_s must be in [0, 1000]";
+  return {};
+}
+
+std::string validate(const ShadingSpec& s) {
+  if (!std::isfinite(s.light_dir.x()) || !std::isfinite(s.light_dir.y()) ||
+      s.light_dir.norm() < 1e-6) {
+    return "shading light_dir must be a finite non-zero vector";
+  }
+  if (!finite_in(s.slope_gain, 0.0, 10.0)) return "shading slope_gain must be in [0, 10]";
+  if (!finite_in(s.press_gain_per_mm, 0.0, 1.0))
+    return "shading press_gain_per_mm must be in [0, 1]";
+  return {};
+}
+
+void PadFields::allocate(const RigSpec& rig) {
+  gw = rig.width / kCellPx;
+  gh = rig.height / kCellPx;
+  pitch_mm = rig.pixel_pitch_mm;
+  cell_mm = kCellPx * rig.pixel_pitch_mm;
+  const double half = 0.5 * (kCellPx - 1);
+  u_mm.resize(static_cast<std::size_t>(gw));
+  v_mm.resize(static_cast<std::size_t>(gh));
+  for (int i = 0; i < gw; ++i) {
+    u_mm[static_cast<std::size_t>(i)] = (kCellPx * i + half - 0.5 * (rig.width - 1)) * pitch_mm;
+  }
+  for (int j = 0; j < gh; ++j) {
+    v_mm[static_cast<std::size_t>(j)] = (kCellPx * j + half - 0.5 * (rig.height - 1)) * pitch_mm;
+  }
+  const auto n = static_cast<std::size_t>(gw) * static_cast<std::size_t>(gh);
+  height_mm.assign(n, kNaN);
+  depth_mm.assign(n, 0.0);
+  contact.assign(n, 0);
+  smooth_depth_mm.assign(n, 0.0);
+  normal_x.assign(n, 0.0);
+  normal_y.assign(n, 0.0);
+  tangential_x.assign(n, 0.0);
+  tangential_y.assign(n, 0.0);
+  total_x.assign(n, 0.0);
+  total_y.assign(n, 0.0);
+  slide_vx.assign(n, 0.0);
+  slide_vy.assign(n, 0.0);
+  shade.assign(n, 1.0);
+  pad_surface_mm = 0.0;
+}
+
+void PadPhysics::build(Sensor sensor, const RigSpec& rig, const GelSpec& gel,
+                       const ShadingSpec& shading) {
+  sensor_ = sensor;
+  rig_ = rig;
+  gel_ = gel;
+  shading_ = shading;
+  rpad_ = pad_rotation(sensor);
+  f_.allocate(rig);
+  const double sigma_cells = gel.bulge_sigma_mm / f_.cell_mm;
+  gauss_radius_ = std::max(1, static_cast<int>(std::ceil(3.0 * sigma_cells)));
+  gauss_.assign(static_cast<std::size_t>(2 * gauss_radius_ + 1), 0.0);
+  double sum = 0.0;
+  for (int k = -gauss_radius_; k <= gauss_radius_; ++k) {
+    sum += std::exp(-0.5 * k * k / (sigma_cells * sigma_cells));
+  }
+  for (int k = -gauss_radius_; k <= gauss_radius_; ++k) {
+    gauss_[static_cast<std::size_t>(k + gauss_radius_)] =
+        static_cast<double>(std::exp(-0.5 * k * k / (sigma_cells * sigma_cells)) / sum);
+  }
+  scratch_.assign(f_.depth_mm.size(), 0.0);
+  reset();
+}
+
+void PadPhysics::reset() noexcept {
+  std::fill(f_.height_mm.begin(), f_.height_mm.end(), kNaN);
+  for (auto* v : {&f_.depth_mm, &f_.smooth_depth_mm, &f_.normal_x, &f_.normal_y, &f_.tangential_x,
+                  &f_.tangential_y, &f_.total_x, &f_.total_y, &f_.slide_vx, &f_.slide_vy}) {
+    std::fill(v->begin(), v->end(), 0.0);
+  }
+  std::fill(f_.contact.begin(), f_.contact.end(), std::uint8_t{0});
+  std::fill(f_.shade.begin(), f_.shade.end(), 1.0);
+  labels_ = PadLabels{};
+  has_last_ = false;
+  has_height_ = false;
+  t_last_ = 0.0;
+  local_last_ = 0.0;
+  hmax_ = 0.0;
+}
+
+double PadPhysics::trace_height(const Shape& shape, const Eigen::Vector3d& a,
+                                const Eigen::Vector3d& b, double n_top, double n_bot,
+                                bool* inside_at_top, int* evals) noexcept {
+  const double lip = shape.lipschitz();
+  double n_out = n_top;
+  double f_out = shape.sdf(a + n_top * b);
+  ++*evals;
+  if (f_out <= 0.0) {
+    *inside_at_top = true;
+    return n_top;
+  }
+  if (f_out > (n_top - n_bot) * lip) return kNaN;  // the surface is farther than the band
+  double n_in = kNaN;
+  double f_in = 0.0;
+  // Sphere tracing along -n: steps of f / L never cross the surface.
+  for (int it = 0; it < 160; ++it) {
+    const double step = std::max(f_out / lip, 1e-3);
+    double n_next = n_out - step;
+    if (n_next < n_bot) n_next = n_bot;
+    const double f_next = shape.sdf(a + n_next * b);
+    ++*evals;
+    if (f_next <= 0.0) {
+      n_in = n_next;
+      f_in = f_next;
+      break;
+    }
+    if (n_next <= n_bot) return kNaN;
+    n_out = n_next;
+    f_out = f_next;
+  }
+  if (std::isnan(n_in)) return kNaN;  // grazing ray
+  // Illinois regula falsi on the bracket [n_in (inside), n_out (outside)].
+  int side = 0;
+  for (int it = 0; it < 24 && (n_out - n_in) > 1e-7; ++it) {
+    const double n_mid = (n_in * f_out - n_out * f_in) / (f_out - f_in);
+    const double f_mid = shape.sdf(a + n_mid * b);
+    ++*evals;
+    if (f_mid > 0.0) {
+      n_out = n_mid;
+      f_out = f_mid;
+      if (side == -1) f_in *= 0.5;
+      side = -1;
+    } else {
+      n_in = n_mid;
+      f_in = f_mid;
+      if (side == 1) f_out *= 0.5;
+      side = 1;
+    }
+    if (std::abs(f_mid) < 1e-9) break;
+  }
+  return f_out < -f_in ? n_out : n_in;
+}
+
+bool PadPhysics::compute_contact(const Scenario& scn, const Shape& shape, double t,
+                                 double dt) noexcept {
+  const Pose pose = scn.pose(t);
+  const Eigen::Matrix3d rt = pose.q.conjugate().toRotationMatrix();
+  const Eigen::Matrix3d m = rt * rpad_.transpose();  // pad vectors -> object-centred vectors
+  const Eigen::Vector3d off(scn.object().offset_mm.x(), scn.object().offset_mm.y(), 0.0);
+  const Eigen::Vector3d base = -(rt * pose.p) - off;
+  const Eigen::Vector3d mu = m.col(0), mv = m.col(1), b = m.col(2);
+  const double reach = shape.bounding_radius() + off.norm() + pose.p.norm() + 1.0;
+  const double indent = scn.indentation_mm(t);
+
+  bool full = !has_height_;
+  int hits = 0;
+  double hmax = -std::numeric_limits<double>::infinity();
+  int evals = 0;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    double top = reach, bot = -reach;
+    if (!full) {
+      const Twist tw1 = scn.twist(t);
+      const Twist tw0 = scn.twist(std::max(0.0, t - dt));
+      const double speed =
+          std::max(tw1.w.norm(), tw0.w.norm()) * reach + std::max(tw1.v.norm(), tw0.v.norm());
+      const double margin = 1.5 * speed * dt + 0.02;
+      top = hmax_ + margin;
+      bot = hmax_ - margin - std::max(0.0, indent) - 0.05;
+    }
+    bool inside = false;
+    hits = 0;
+    hmax = -std::numeric_limits<double>::infinity();
+    for (int j = 0; j < f_.gh; ++j) {
+      const Eigen::Vector3d row = base + f_.v_mm[static_cast<std::size_t>(j)] * mv;
+      for (int i = 0; i < f_.gw; ++i) {
+        const Eigen::Vector3d a = row + f_.u_mm[static_cast<std::size_t>(i)] * mu;
+        const double h = trace_height(shape, a, b, top, bot, &inside, &evals);
+        f_.height_mm[f_.index(i, j)] = h;
+        if (!std::isnan(h)) {
+          ++hits;
+          hmax = std::max(hmax, h);
+        }
+      }
+    }
+    if (!full && (inside || hits == 0)) {
+      full = true;  // the object moved out of the tracked band: trace the whole range again
+      continue;
+    }
+    break;
+  }
+  labels_.trace_sdf_evals = evals;
+  if (hits == 0) {
+    has_height_ = false;
+    std::fill(f_.depth_mm.begin(), f_.depth_mm.end(), 0.0);
+    std::fill(f_.contact.begin(), f_.contact.end(), std::uint8_t{0});
+    return false;
+  }
+  has_height_ = true;
+  // The highest object point generally lies between cell centres: refine it with a few extra
+  // rays, moving to the vertex of a parabola through three samples along u, then along v
+  // (exact for a locally quadratic cap; a flat face has no curvature and stays as sampled).
+  std::size_t kmax = 0;
+  for (std::size_t k = 0; k < f_.height_mm.size(); ++k) {
+    if (f_.height_mm[k] == hmax) {
+      kmax = k;
+      break;
+    }
+  }
+  {
+    double pu = f_.u_mm[kmax % static_cast<std::size_t>(f_.gw)];
+    double pv = f_.v_mm[kmax / static_cast<std::size_t>(f_.gw)];
+    const double top = hmax + 0.5 * f_.cell_mm, bot = hmax - f_.cell_mm;
+    auto h_at = [&](double u, double v) {
+      bool inside = false;
+      const double h = trace_height(shape, base + u * mu + v * mv, b, top, bot, &inside, &evals);
+      return std::isnan(h) ? -1e30 : h;
+    };
+    double step = 0.5 * f_.cell_mm;
+    for (int round = 0; round < 3; ++round, step *= 0.5) {
+      for (int axis = 0; axis < 2; ++axis) {
+        const double du = axis == 0 ? step : 0.0, dv = axis == 0 ? 0.0 : step;
+        const double hm = h_at(pu - du, pv - dv), hp = h_at(pu + du, pv + dv);
+        const double curv = hm - 2.0 * hmax + hp;
+        if (curv >= -1e-12) continue;
+        const double x = std::clamp(0.5 * (hm - hp) / curv, -1.0, 1.0);
+        const double h = h_at(pu + x * du, pv + x * dv);
+        if (h > hmax) {
+          hmax = h;
+          pu += x * du;
+          pv += x * dv;
+        }
+      }
+    }
+  }
+  labels_.trace_sdf_evals = evals;
+  hmax_ = hmax;
+  // Force-controlled pad: its undeformed surface sits `indent` below the highest object point.
+  const double surface = hmax - indent;
+  f_.pad_surface_mm = surface;
+  for (std::size_t k = 0; k < f_.depth_mm.size(); ++k) {
+    const double h = f_.height_mm[k];
+    const double d = std::isnan(h) ? 0.0 : std::max(0.0, h - surface);
+    f_.depth_mm[k] = static_cast<double>(d);
+    f_.contact[k] = d > kContactEpsMm ? 1 : 0;
+  }
+  return true;
+}
+
+void PadPhysics::compute_normal() noexcept {
+  const int gw = f_.gw, gh = f_.gh, r = gauss_radius_;
+  // Separable Gaussian with clamped borders: Phi = G_sigma * d.
+  for (int j = 0; j < gh; ++j) {
+    for (int i = 0; i < gw; ++i) {
+      double acc = 0.0;
+      for (int k = -r; k <= r; ++k) {
+        const int ii = std::clamp(i + k, 0, gw - 1);
+        acc += gauss_[static_cast<std::size_t>(k + r)] * f_.depth_mm[f_.index(ii, j)];
+      }
+      scratch_[f_.index(i, j)] = acc;
+    }
+  }
+  for (int j = 0; j < gh; ++j) {
+    for (int i = 0; i < gw; ++i) {
+      double acc = 0.0;
+      for (int k = -r; k <= r; ++k) {
+        const int jj = std::clamp(j + k, 0, gh - 1);
+        acc += gauss_[static_cast<std::size_t>(k + r)] * scratch_[f_.index(i, jj)];
+      }
+      f_.smooth_depth_mm[f_.index(i, j)] = acc;
+    }
+  }
+  const Eigen::Vector2d l = shading_.light_dir.normalized();
+  const auto k_n = static_cast<double>(gel_.bulge_gain_mm);
+  const auto inv2c = static_cast<double>(0.5 / f_.cell_mm);
+  const auto& phi = f_.smooth_depth_mm;
+  for (int j = 0; j < gh; ++j) {
+    for (int i = 0; i < gw; ++i) {
+      const std::size_t k = f_.index(i, j);
+      const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, gw - 1);
+      const int j0 = std::max(j - 1, 0), j1 = std::min(j + 1, gh - 1);
+      const double gx = (phi[f_.index(i1, j)] - phi[f_.index(i0, j)]) * inv2c *
+                        (2.0 / static_cast<double>(i1 - i0));
+      const double gy = (phi[f_.index(i, j1)] - phi[f_.index(i, j0)]) * inv2c *
+                        (2.0 / static_cast<double>(j1 - j0));
+      f_.normal_x[k] = -k_n * gx;
+      f_.normal_y[k] = -k_n * gy;
+      f_.shade[k] = static_cast<double>(1.0 +
+                                        shading_.slope_gain * (static_cast<double>(gx) * l.x() +
+                                                               static_cast<double>(gy) * l.y()) -
+                                        shading_.press_gain_per_mm * static_cast<double>(phi[k]));
+    }
+  }
+}
+
+void PadPhysics::compute_tangential(const Scenario& scn, const Pose& pose, double t, double dt,
+                                    double umax_per_mm) noexcept {
+  const Twist tw = scn.twist(t);
+  const bool sliding = scn.sliding();
+  int nsub = 0;
+  double decay = 0.0;
+  if (sliding && dt > 0.0) {
+    nsub = std::clamp(static_cast<int>(std::ceil(dt / (0.25 * gel_.lag_time_s))), 1, kMaxSubsteps);
+    const double hs = dt / nsub;
+    decay = 1.0 - std::exp(-hs / gel_.lag_time_s);
+    for (int s = 0; s < nsub; ++s) {
+      const Twist tws = scn.twist(t - dt + (s + 0.5) * hs);
+      sub_w_[static_cast<std::size_t>(s)] = tws.w;
+      sub_v_[static_cast<std::size_t>(s)] = tws.v;
+    }
+  }
+  const double c = gel_.drag_time_s;
+  for (int j = 0; j < f_.gh; ++j) {
+    for (int i = 0; i < f_.gw; ++i) {
+      const std::size_t k = f_.index(i, j);
+      if (!f_.contact[k]) {
+        f_.slide_vx[k] = 0.0;
+        f_.slide_vy[k] = 0.0;
+        continue;
+      }
+      // Contact point: the object's surface point now touching this gel cell, in G.
+      const Eigen::Vector3d c_pad(f_.u_mm[static_cast<std::size_t>(i)],
+                                  f_.v_mm[static_cast<std::size_t>(j)], f_.height_mm[k]);
+      const Eigen::Vector3d c_g = rpad_.transpose() * c_pad;
+      const Eigen::Vector3d vel = rpad_ * tw.velocity_at(c_g);
+      f_.slide_vx[k] = static_cast<double>(vel.x());
+      f_.slide_vy[k] = static_cast<double>(vel.y());
+      if (!sliding) {
+        // Stick: the gel point now at c was carried there by the object, from where the same
+        // object point was before the motion (the pose is the identity before the motion).
+        const Eigen::Vector3d disp = rpad_ * (c_g - pose.apply_inverse(c_g));
+        f_.tangential_x[k] = static_cast<double>(disp.x());
+        f_.tangential_y[k] = static_cast<double>(disp.y());
+        continue;
+      }
+      // Slide: tau dU/dt = c v - U, integrated exactly per sub-step, then the Coulomb cap.
+      double ux = f_.tangential_x[k], uy = f_.tangential_y[k];
+      const double umax = umax_per_mm * static_cast<double>(f_.depth_mm[k]);
+      for (int s = 0; s < nsub; ++s) {
+        const auto si = static_cast<std::size_t>(s);
+        const Eigen::Vector3d vs = rpad_ * (sub_w_[si].cross(c_g) + sub_v_[si]);
+        ux += (c * vs.x() - ux) * decay;
+        uy += (c * vs.y() - uy) * decay;
+        const double mag = std::hypot(ux, uy);
+        if (mag > umax) {
+          const double scale = umax / mag;
+          ux *= scale;
+          uy *= scale;
+        }
+      }
+      const double mag = std::hypot(ux, uy);
+      if (mag > umax) {
+        ux *= umax / mag;
+        uy *= umax / mag;
+      }
+      f_.tangential_x[k] = static_cast<double>(ux);
+      f_.tangential_y[k] = static_cast<double>(uy);
+    }
+  }
+}
+
+void PadPhysics::spread() noexcept {
+  const int gw = f_.gw, gh = f_.gh;
+  bool any = false;
+  for (auto c : f_.contact) any = any || c != 0;
+  if (!any) {
+    std::fill(f_.tangential_x.begin(), f_.tangential_x.end(), 0.0);
+    std::fill(f_.tangential_y.begin(), f_.tangential_y.end(), 0.0);
+    labels_.spread_sweeps = 0;
+    return;
+  }
+  // Thin elastic layer on a rigid backing: outside the patch the in-plane displacement obeys
+  // lambda^2 lap(U) = U (screened Poisson), with U given on the patch and free (Neumann)
+  // image borders. Red-black SOR, warm-started from the previous frame.
+  const double alpha = static_cast<double>(std::pow(f_.cell_mm / gel_.spread_length_mm, 2.0));
+  const auto omega = static_cast<double>(kSorOmega);
+  double* ux = f_.tangential_x.data();
+  double* uy = f_.tangential_y.data();
+  const std::uint8_t* fixed = f_.contact.data();
+  int sweep = 0;
+  for (; sweep < kSorMaxSweeps; ++sweep) {
+    double max_delta = 0.0;
+    for (int parity = 0; parity < 2; ++parity) {
+      for (int j = 0; j < gh; ++j) {
+        for (int i = (j + parity) & 1; i < gw; i += 2) {
+          const std::size_t k = f_.index(i, j);
+          if (fixed[k]) continue;
+          double sx = 0.0, sy = 0.0, n = 0.0;
+          if (i > 0) {
+            sx += ux[k - 1];
+            sy += uy[k - 1];
+            n += 1.0;
+          }
+          if (i + 1 < gw) {
+            sx += ux[k + 1];
+            sy += uy[k + 1];
+            n += 1.0;
+          }
+          if (j > 0) {
+            sx += ux[k - static_cast<std::size_t>(gw)];
+            sy += uy[k - static_cast<std::size_t>(gw)];
+            n += 1.0;
+          }
+          if (j + 1 < gh) {
+            sx += ux[k + static_cast<std::size_t>(gw)];
+            sy += uy[k + static_cast<std::size_t>(gw)];
+            n += 1.0;
+          }
+          const double inv = 1.0 / (n + alpha);
+          const double dx = sx * inv - ux[k];
+          const double dy = sy * inv - uy[k];
+          ux[k] += omega * dx;
+          uy[k] += omega * dy;
+          max_delta = std::max(max_delta, std::max(std::abs(dx), std::abs(dy)));
+        }
+      }
+    }
+    if (max_delta < static_cast<double>(kSorTolMm)) {
+      ++sweep;
+      break;
+    }
+  }
+  labels_.spread_sweeps = sweep;
+}
+
+void PadPhysics::compute_labels(bool sliding) noexcept {
+  int count = 0, slipping = 0;
+  double su = 0.0, sv = 0.0, peak = 0.0;
+  const double thr2 = gel_.slip_speed_mm_s * gel_.slip_speed_mm_s;
+  for (int j = 0; j < f_.gh; ++j) {
+    for (int i = 0; i < f_.gw; ++i) {
+      const std::size_t k = f_.index(i, j);
+      if (!f_.contact[k]) continue;
+      ++count;
+      su += f_.u_mm[static_cast<std::size_t>(i)];
+      sv += f_.v_mm[static_cast<std::size_t>(j)];
+      peak = std::max(peak, static_cast<double>(f_.depth_mm[k]));
+      const double vx = f_.slide_vx[k], vy = f_.slide_vy[k];
+      const double v2 = vx * vx + vy * vy;
+      if (sliding && v2 > thr2) ++slipping;
+    }
+  }
+  labels_.in_contact = count > 0;
+  labels_.area_mm2 = count * f_.cell_mm * f_.cell_mm;
+  labels_.centroid_mm =
+      count > 0 ? Eigen::Vector2d(su / count, sv / count) : Eigen::Vector2d::Zero();
+  labels_.peak_depth_mm = peak;
+  labels_.slip_fraction = count > 0 ? static_cast<double>(slipping) / count : 0.0;
+  labels_.slipping = labels_.slip_fraction > 0.5;
+}
+
+SimStatus PadPhysics::step(const Scenario& scn, const Shape& shape, double t) noexcept {
+  if (has_last_ && t < t_last_ - 1e-12) return SimStatus::kTimeBackwards;
+  const double local = scn.local_time(t);
+  if (has_last_ && local < local_last_ - 1e-12) reset();  // a new loop cycle starts afresh
+  const double dt = has_last_ ? local - local_last_ : 0.0;
+  const Pose pose = scn.pose(local);
+  compute_contact(scn, shape, local, dt);
+  compute_normal();
+  compute_tangential(scn, pose, local, dt, shape.spec().friction * gel_.shear_compliance);
+  spread();
+  for (std::size_t k = 0; k < f_.total_x.size(); ++k) {
+    f_.total_x[k] = f_.tangential_x[k] + f_.normal_x[k];
+    f_.total_y[k] = f_.tangential_y[k] + f_.normal_y[k];
+  }
+  compute_labels(scn.sliding());
+  t_last_ = t;
+  local_last_ = local;
+  has_last_ = true;
+  return SimStatus::kOk;
+}
+
+}  // namespace tacse3::sim
