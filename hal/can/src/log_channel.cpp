@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 hal/can: candump -L log channel.
+#include "tacse3/hal/can/log_channel.hpp"
+
+#include <time.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "tacse3/protocol/candump.hpp"
+
+namespace tacse3::hal::can {
+namespace {
+
+std::uint64_t realtime_us() {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<std::uint64_t>(ts.tv_sec) * 1000000u +
+         static_cast<std::uint64_t>(ts.tv_nsec) / 1000u;
+}
+
+}  // namespace
+
+std::unique_ptr<LogChannel> LogChannel::open(const std::string& input_path,
+                                             const std::string& output_path, std::string& error,
+                                             std::string iface_name) {
+  std::FILE* in = nullptr;
+  std::FILE* out = nullptr;
+  bool own_in = false, own_out = false;
+  if (input_path == "-") {
+    in = stdin;
+  } else if (!input_path.empty()) {
+    in = std::fopen(input_path.c_str(), "r");
+    if (in == nullptr) {
+      error = "cannot open log '" + input_path + "': " + std::strerror(errno);
+      return nullptr;
+    }
+    own_in = true;
+  }
+  if (output_path == "-") {
+    out = stdout;
+  } else if (!output_path.empty()) {
+    out = std::fopen(output_path.c_str(), "w");
+    if (out == nullptr) {
+      error = "cannot create log '" + output_path + "': " + std::strerror(errno);
+      if (own_in) std::fclose(in);
+      return nullptr;
+    }
+    own_out = true;
+  }
+  auto ch = std::make_unique<LogChannel>(in, out, std::move(iface_name));
+  ch->own_in_ = own_in;
+  ch->own_out_ = own_out;
+  return ch;
+}
+
+LogChannel::LogChannel(std::FILE* in, std::FILE* out, std::string iface_name)
+    : in_(in), out_(out), iface_(std::move(iface_name)), now_us_(realtime_us) {
+  if (iface_.empty() || iface_.size() > 16) iface_ = "can0";
+}
+
+LogChannel::~LogChannel() {
+  if (own_in_ && in_ != nullptr) std::fclose(in_);
+  if (own_out_ && out_ != nullptr) std::fclose(out_);
+}
+
+bool LogChannel::send(const CanFrame& f) {
+  if (out_ == nullptr) {
+    error_ = "log channel has no output";
+    return false;
+  }
+  protocol::LogRecord r;
+  r.time_us = now_us_();
+  std::memcpy(r.iface.data(), iface_.c_str(), iface_.size() + 1);
+  r.frame = f;
+  char line[protocol::kCandumpLineMax + 2];
+  const std::size_t n = protocol::format_candump_line(r, line, sizeof line - 1);
+  if (n == 0) {
+    error_ = "frame cannot be written as a candump line";
+    return false;
+  }
+  line[n] = '\n';
+  if (std::fwrite(line, 1, n + 1, out_) != n + 1 || std::fflush(out_) != 0) {
+    error_ = std::string("writing the log failed: ") + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+RxResult LogChannel::receive(RxFrame& out, int /*timeout_ms*/) {
+  if (in_ == nullptr) return RxResult::kEnd;
+  char line[512];
+  while (std::fgets(line, sizeof line, in_) != nullptr) {
+    std::size_t len = std::strlen(line);
+    if (len == sizeof line - 1 && line[len - 1] != '\n') {
+      // Longer than any candump line: skip the rest of it.
+      int c = 0;
+      while ((c = std::fgetc(in_)) != EOF && c != '\n') {
+      }
+      ++lines_;
+      ++bad_lines_;
+      continue;
+    }
+    ++lines_;
+    while (len > 0 && (line[len - 1] == '\n' || line[len - 1] == '\r')) line[--len] = '\0';
+    if (len == 0) continue;
+    protocol::LogRecord r;
+    if (protocol::parse_candump_line(std::string_view(line, len), r) != protocol::Status::kOk) {
+      ++bad_lines_;
+      continue;
+    }
+    if (r.rtr || r.error_frame) {
+      ++skipped_;
+      continue;
+    }
+    out.frame = r.frame;
+    out.time_us = r.time_us;
+    return RxResult::kFrame;
+  }
+  if (std::ferror(in_) != 0) {
+    error_ = std::string("reading the log failed: ") + std::strerror(errno);
+    return RxResult::kError;
+  }
+  return RxResult::kEnd;
+}
+
+}  // namespace tacse3::hal::can

@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 protocol: the hal/can log channel round trip and the SocketCAN failure message.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+
+#include "tacse3/hal/can/log_channel.hpp"
+#include "tacse3/hal/can/socketcan.hpp"
+#include "tacse3/protocol/protocol.hpp"
+
+namespace can = tacse3::hal::can;
+namespace tp = tacse3::protocol;
+
+TEST(LogChannel, WritesAndReadsBackEveryFrameKind) {
+  std::FILE* tmp = std::tmpfile();
+  ASSERT_NE(tmp, nullptr);
+  can::LogChannel writer(nullptr, tmp, "vcan0");
+  std::uint64_t now = 1700000000000001ull;
+  writer.set_clock([&] { return now++; });
+  tp::CycleFrames classic, fd;
+  tp::TxConfig tx;
+  ASSERT_EQ(tp::encode_cycle(tp::Cycle{}, 1, tx, classic), tp::Status::kOk);
+  tx.frame_mode = tp::FrameMode::kFd;
+  tx.endpoint.layout.mode = tp::IdMode::kExtended;
+  ASSERT_EQ(tp::encode_cycle(tp::Cycle{}, 2, tx, fd), tp::Status::kOk);
+  for (std::size_t i = 0; i < classic.count; ++i) ASSERT_TRUE(writer.send(classic.frames[i]));
+  ASSERT_TRUE(writer.send(fd.frames[0]));
+  std::fputs("garbage line\n(1.0) can0 7FF#R\n", tmp);
+  std::rewind(tmp);
+
+  can::LogChannel reader(tmp, nullptr);
+  can::RxFrame rx;
+  for (std::size_t i = 0; i < classic.count; ++i) {
+    ASSERT_EQ(reader.receive(rx, 0), can::RxResult::kFrame);
+    EXPECT_EQ(rx.time_us, 1700000000000001ull + i);
+    EXPECT_EQ(rx.frame.id, classic.frames[i].id);
+    EXPECT_EQ(rx.frame.len, 8);
+    EXPECT_EQ(rx.frame.data, classic.frames[i].data);
+  }
+  ASSERT_EQ(reader.receive(rx, 0), can::RxResult::kFrame);
+  EXPECT_TRUE(rx.frame.fd);
+  EXPECT_TRUE(rx.frame.brs);
+  EXPECT_TRUE(rx.frame.extended);
+  EXPECT_EQ(rx.frame.len, 64);
+  EXPECT_EQ(rx.frame.data, fd.frames[0].data);
+  EXPECT_EQ(reader.receive(rx, 0), can::RxResult::kEnd);
+  EXPECT_EQ(reader.bad_lines(), 1u);
+  EXPECT_EQ(reader.skipped_frames(), 1u);  // the remote frame
+  std::fclose(tmp);
+}
+
+TEST(LogChannel, ReportsMissingFiles) {
+  std::string error;
+  EXPECT_EQ(can::LogChannel::open("/nonexistent/tacse3.log", "", error), nullptr);
+  EXPECT_NE(error.find("cannot open log"), std::string::npos);
+  can::LogChannel none(nullptr, nullptr);
+  EXPECT_FALSE(none.send(tp::CanFrame{}));
+  can::RxFrame rx;
+  EXPECT_EQ(none.receive(rx, 0), can::RxResult::kEnd);
+}
+
+// This host's kernel has no AF_CAN; on a CAN-capable host the interface does not exist. Either
+// way open() fails with a message that says what is wrong.
+TEST(SocketCan, FailsWithAClearError) {
+  std::string error;
+  auto ch = can::SocketCanChannel::open("tacse3nope0", can::SocketCanOptions{}, error);
+  EXPECT_EQ(ch, nullptr);
+  const bool no_af_can = error.find("SocketCAN is not available on this host") != std::string::npos;
+  const bool no_iface = error.find("no CAN interface 'tacse3nope0'") != std::string::npos;
+  EXPECT_TRUE(no_af_can || no_iface) << error;
+  error.clear();
+  EXPECT_EQ(can::SocketCanChannel::open("", can::SocketCanOptions{}, error), nullptr);
+  EXPECT_FALSE(error.empty());
+}
