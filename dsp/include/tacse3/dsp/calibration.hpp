@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 dsp: per-sensor calibration of the back end (forces, contact, motion proxy, solve).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "tacse3/dsp/types.hpp"
+
+namespace tacse3::dsp {
+
+// How the calibrated shear field becomes the per-point motion proxy ṽ of paper Sec. IV-C.
+enum class VelocityProxy : std::uint8_t {
+  // Paper model: the calibrated shear is proportional to the contact velocity,
+  // ṽ = c_velocity · shear. Suits the sliding regime.
+  kVelocity = 0,
+  // The increment of the shear field between consecutive frames is the contact displacement,
+  // ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt. Exact kinematics while the contact sticks.
+  kDisplacement = 1,
+};
+
+// Largest moving-average window (frames). Sizes the ring buffer at compile time.
+inline constexpr int kMaxMovingAverage = 32;
+
+// All fields are doubles in SI units (or dimensionless); they are validated by validate() and
+// converted once to the fixed-point formats of the per-grid stages by each stage's configure().
+// "shear unit" = one working-image pixel of calibrated shear (shear gains of 1 keep the NHHD
+// parts' unit); "f^z unit" = the dimensionless normal response (relative local expansion when
+// normal_gain_density = 1). Ranges are the ones validate() enforces.
+struct Calibration {
+  // --- contact-point geometry (paper Sec. IV-B, κx = 1/pixel_pitch_m, κy = κx/pixel_aspect_y)
+  double pixel_pitch_m = 0.075e-3;  // sensor pixel → metres along x. [1e-6, 2e-4]
+  double pixel_aspect_y = 1.0;      // pitch_y / pitch_x. [0.25, 4]
+
+  // --- normal response f^z = a_G · (−𝒢) + a_div · div(d)   (dimensionless inputs)
+  double normal_gain_density = 1.0;     // per unit of −𝒢. [0, 1e4]
+  double normal_gain_divergence = 0.0;  // per unit of div d (working px / working px). [0, 1e4]
+
+  // --- shear (f^x, f^y) = s_d · d + s_r · r + s_k · k  (Eq. nhhd parts, working px)
+  // Default: the curl-free part d is the radial bulge of normal indentation, not shear.
+  double shear_gain_d = 0.0;  // [0, 1e4]
+  double shear_gain_r = 1.0;  // [0, 1e4]
+  double shear_gain_k = 1.0;  // [0, 1e4]
+
+  // --- contact mask Ω = {filter(f^z) > τ} with hysteresis and a minimum area
+  double contact_tau_on = 0.02;    // new cells need filter(f^z) > τ_on. (0, 1e4]
+  double contact_tau_off = 0.01;   // cells of last frame's Ω stay while > τ_off. [0, τ_on]
+  int contact_min_area_cells = 4;  // smaller 4-connected components are dropped. [1, kGridCount]
+
+  // --- height map z = g(f^z) = min(height_gain_m · max(f^z, 0), height_max_m)
+  double height_gain_m = 5.0e-3;  // metres per f^z unit. [0, 1]
+  double height_max_m = 2.0e-3;   // clamp. [0, 0.01]
+
+  // --- velocity proxy (issue item 12)
+  VelocityProxy velocity_proxy = VelocityProxy::kVelocity;
+  // m/s per shear unit. Default: one working pixel of shear read as one frame's contact
+  // displacement at 120 Hz, 2 · 0.075 mm · 120 Hz. (0, 100]
+  double c_velocity = 2.0 * 0.075e-3 * 120.0;
+  // metres per shear unit. Default 2 · pixel_pitch_m: exact kinematics, since shear is in
+  // working pixels (1 working px = 2 sensor px). Change it together with pixel_pitch_m. (0, 1]
+  double c_displacement = 2.0 * 0.075e-3;
+
+  // --- translation (contact-centroid displacement, paper Sec. IV-D)
+  // If the mask changes by more than this fraction between frames (1 − Jaccard index), the
+  // mask-centroid displacement is replaced by the mean displacement of the material points in
+  // both masks, so area changes do not produce spikes. [0, 1]
+  double max_mask_change = 0.3;
+
+  // --- per-axis scales applied to this sensor's estimates, in its own frame. [0, 100]
+  std::array<double, 3> rotation_scale{1.0, 1.0, 1.0};
+  std::array<double, 3> translation_scale{1.0, 1.0, 1.0};
+
+  // --- temporal smoothing (paper Sec. IV-D moving average). [1, kMaxMovingAverage]
+  int moving_average_length = 4;
+
+  // --- 3x3 solve regularisation (solve3.hpp): λ = solve_lambda_rel · tr(AᵀA)/3
+  //     + N · solve_lever_floor_m², validity needs rcond ≥ solve_rcond_min.
+  double solve_lambda_rel = 1e-6;     // [0, 1]
+  double solve_lever_floor_m = 1e-5;  // [0, 1e-2]
+  double solve_rcond_min = 1e-4;      // [0, 1)
+};
+
+// kOk, or kBadCalibration if any field is NaN/inf or outside the range documented above
+// (including τ_off > τ_on and an unknown velocity_proxy value).
+Status validate(const Calibration& cal) noexcept;
+
+}  // namespace tacse3::dsp

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 dsp: per-sensor motion: contact-centroid translation, velocity proxy, int64 moments, ω.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "tacse3/dsp/calibration.hpp"
+#include "tacse3/dsp/contact.hpp"
+#include "tacse3/dsp/solve3.hpp"
+#include "tacse3/dsp/types.hpp"
+
+namespace tacse3::dsp {
+
+// Velocity-proxy samples entering the moments are clamped to ±kMaxProxyQ16 (Q16 shear units,
+// ±128 working px) so that the moment sums below cannot overflow int64.
+inline constexpr std::int32_t kMaxProxyQ16 = (std::int32_t{1} << 23) - 1;
+
+// Per-sensor sufficient statistics of the shear-only least squares (Eq. twist_ls restricted to
+// ω, paper Sec. IV-C/D), accumulated over Ω in the SENSOR frame.
+// Units: q in nm (contact.hpp), ṽ in Q16 proxy units (shear, or shear increment, per point);
+// ṽ_z = 0 (shear-only). Scaling and overflow: N ≤ 1200 < 2^11, |q_x|,|q_y| < 2^25, 0 ≤ q_z < 2^24,
+// |ṽ| < 2^23, so Σ q qᵀ < 2^61 and Σ q ṽ < 2^59: exact in int64, no saturation needed.
+struct ContactMoments {
+  std::int64_t n = 0;
+  std::int64_t sx = 0, sy = 0, sz = 0;                                // Σ q
+  std::int64_t sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;  // Σ q qᵀ
+  std::int64_t svx = 0, svy = 0;                                      // Σ ṽ
+  std::int64_t sx_vy = 0, sy_vx = 0, sz_vx = 0, sz_vy = 0;  // Σ q_a ṽ_b used by Σ q×ṽ
+};
+
+// The same sums in double and SI units (m, m/s), in some frame F, plus the unit normal n_F of the
+// sensor whose points they are (the direction whose velocity equation is dropped).
+struct MomentSums {
+  double n = 0.0;
+  Eigen::Vector3d s1 = Eigen::Vector3d::Zero();    // Σ q
+  Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();    // Σ q qᵀ
+  Eigen::Vector3d sv = Eigen::Vector3d::Zero();    // Σ ṽ
+  Eigen::Vector3d sqxv = Eigen::Vector3d::Zero();  // Σ q × ṽ
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+};
+
+// Integer moments → SI, sensor frame (normal = +z_S). proxy_scale: (m/s) per Q16 proxy LSB.
+MomentSums to_metric(const ContactMoments& m, double proxy_scale) noexcept;
+
+// Moments of the transformed points q' = R q + p and vectors ṽ' = R ṽ (R orthonormal):
+//   Σq' = R Σq + N p,  Σq'q'ᵀ = R Σqqᵀ Rᵀ + (R Σq) pᵀ + p (R Σq)ᵀ + N p pᵀ,
+//   Σṽ' = R Σṽ,  Σ q'×ṽ' = R Σ q×ṽ + p × R Σṽ,  n' = R n.
+MomentSums rigid_transform(const MomentSums& m, const Eigen::Matrix3d& R,
+                           const Eigen::Vector3d& p) noexcept;
+
+// Adds one sensor's shear-only normal equations to (AtA, Atb). Per point the residual is the
+// tangential part P(ω × q − ṽ), P = I − n nᵀ; in the sensor frame its rows are exactly the first
+// two rows of the paper's A_i restricted to ω, [0, z, −y] and [−z, 0, x]. Summed:
+//   AᵀA = tr(Σqqᵀ) I − Σqqᵀ − [n]× Σqqᵀ [n]×ᵀ,   Aᵀb = Σ q × ṽ   (ṽ ⟂ n).
+void add_normal_equations(const MomentSums& m, Eigen::Matrix3d& AtA, Eigen::Vector3d& Atb) noexcept;
+
+enum class TranslationSource : std::uint8_t {
+  kNone = 0,          // no translation this frame (no contact now or in the previous frame)
+  kCentroid = 1,      // displacement of the mask centroid (paper Sec. IV-D)
+  kCommonPoints = 2,  // mask changed too much: mean displacement of points in both masks
+};
+
+// Per-sensor, per-frame result (sensor frame S).
+struct SensorMotion {
+  bool contact = false;
+  int points = 0;
+  ContactMoments moments;    // this frame's Ω, sensor frame
+  double proxy_scale = 0.0;  // (m/s) per Q16 LSB of the proxy in `moments`
+  bool proxy_valid = false;  // false on the first displacement-mode frame after reset
+  Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();  // 3D centroid of q over Ω (m)
+  // Contact-centroid velocity (m/s), t_z = 0, translation_scale applied.
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  bool translation_valid = false;
+  TranslationSource translation_source = TranslationSource::kNone;
+  double mask_change = 0.0;  // 1 − Jaccard(Ω_t, Ω_{t−1}); 1 when either is empty
+  // Own-frame shear-only rotation (rad/s), rotation_scale applied; what the paper fuses.
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero();
+  Solve3Result solve;
+  bool rotation_valid = false;  // contact && proxy_valid && solve.valid
+  Eigen::Vector3d rotation_scale = Eigen::Vector3d::Ones();  // copied for the joint fusion
+};
+
+// Per-sensor motion stage. State: previous mask, positions, centroid sums and shear field
+// (≈ 25 KB), no heap.
+//  - Translation (paper Sec. IV-D "contact-centroid planar translation"): c_t = mean of the
+//    current positions over Ω_t; t = (c_t − c_{t−1}) / Δt, t_z = 0. Spike rules:
+//      * onset (Ω_{t−1} empty) or loss (Ω_t empty): t = 0, translation_valid = false;
+//      * if 1 − |Ω_t ∩ Ω_{t−1}| / |Ω_t ∪ Ω_{t−1}| > max_mask_change, cells entering/leaving
+//        would move the centroid without any object motion, so t is the mean displacement of
+//        the material points present in both masks (exact while the contact sticks);
+//      * otherwise the mask-centroid displacement (also follows a sliding patch).
+//  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear; kDisplacement
+//    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt, the previous shear kept per sensor.
+//  - Rotation: int64 moments over Ω, then in double the own-frame normal equations and
+//    solve3 with λ = λ_rel tr/3 + N · lever_floor².
+class MotionEstimator {
+ public:
+  MotionEstimator() noexcept;  // configured with Calibration{} defaults
+  // kBadCalibration (previous configuration kept) if validate(cal) fails.
+  Status configure(const Calibration& cal) noexcept;
+  // Forget the previous frame (call on tare and after a gap in the stream).
+  void reset() noexcept;
+
+  // contact: this frame's ContactSet; shear: calibrated shear field (Q16 shear units);
+  // dt_s: time since the previous frame, finite and in (0, 1] s.
+  // Bad dt: returns kBadArgument, `out` = no contact / all invalid, state unchanged.
+  Status update(const ContactSet& contact, const VectorField& shear, double dt_s,
+                SensorMotion& out) noexcept;
+
+ private:
+  VelocityProxy mode_ = VelocityProxy::kVelocity;
+  double c_velocity_ = 0.0;
+  double c_displacement_ = 0.0;
+  double max_mask_change_ = 0.0;
+  Eigen::Vector3d rotation_scale_ = Eigen::Vector3d::Ones();
+  Eigen::Vector3d translation_scale_ = Eigen::Vector3d::Ones();
+  Solve3Options solve_options_;
+  double lever_floor_m_ = 0.0;
+
+  GridMask prev_mask_;
+  GridArray<std::int32_t> prev_x_nm_;
+  GridArray<std::int32_t> prev_y_nm_;
+  std::int64_t prev_count_ = 0;
+  std::int64_t prev_sx_ = 0;
+  std::int64_t prev_sy_ = 0;
+  VectorField prev_shear_;
+  bool have_prev_shear_ = false;
+};
+
+}  // namespace tacse3::dsp

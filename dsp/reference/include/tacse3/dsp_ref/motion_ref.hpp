@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 dsp reference: brute-force stacked least squares and per-sensor motion in double.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "tacse3/dsp/calibration.hpp"
+#include "tacse3/dsp/types.hpp"
+#include "tacse3/dsp_ref/contact_ref.hpp"
+
+namespace tacse3::dsp_ref {
+
+// One contact point with its velocity proxy and the normal of its sensor (all in one frame).
+struct PointSample {
+  Eigen::Vector3d q = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+};
+
+// Eq. (twist_ls) restricted to ω, stacked explicitly: two rows per point, e_kᵀ(ω × q) = e_kᵀ ṽ
+// for a tangent basis (e_1, e_2) of the point's normal. For n = z these are the paper's rows
+// [0, z, −y] and [−z, 0, x].
+struct StackedSystem {
+  Eigen::MatrixXd A;  // 2N x 3
+  Eigen::VectorXd b;  // 2N
+};
+StackedSystem stack_shear_rows(const std::vector<PointSample>& pts);
+
+// argmin ‖Aω − b‖² + λ‖ω‖², by a column-pivoting QR of the augmented [A; √λ I].
+Eigen::Vector3d solve_stacked(const StackedSystem& s, double lambda);
+
+// Centroid of the points (the joint fusion's reference for the solve).
+Eigen::Vector3d centroid(const std::vector<PointSample>& pts);
+// Points shifted by −c (velocities unchanged).
+std::vector<PointSample> shifted(const std::vector<PointSample>& pts, const Eigen::Vector3d& c);
+
+struct SensorMotionRef {
+  bool contact = false;
+  int points = 0;
+  std::vector<PointSample> samples;  // sensor frame, proxy in m/s
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();  // scaled, t_z = 0
+  bool translation_valid = false;
+  int translation_source = 0;                       // as dsp::TranslationSource
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero();  // scaled, own-frame stacked LS
+  bool proxy_valid = false;
+};
+
+// Same rules as dsp::MotionEstimator (translation sources, proxy modes, λ), in double.
+class MotionRef {
+ public:
+  explicit MotionRef(const dsp::Calibration& cal = {});
+  void reset();
+  // shear_x/shear_y: calibrated shear (shear units, real values) per grid point.
+  SensorMotionRef update(const ContactSetRef& c, const std::vector<double>& shear_x,
+                         const std::vector<double>& shear_y, double dt);
+
+ private:
+  dsp::Calibration cal_;
+  std::vector<std::uint8_t> prev_mask_;
+  std::vector<Eigen::Vector3d> prev_q_;
+  std::vector<double> prev_sx_, prev_sy_;
+  bool have_prev_shear_ = false;
+};
+
+// --- Analytic scene for tests and benchmarks: one pad touching an object that moves rigidly.
+// The contact is a paraboloid cap of f^z (peak_fz at the centre, 0 at radius_m) centred where
+// contact_centre_G projects onto the pad. The object twist (ω, t) is in G (spatial: t is the
+// velocity of the material point at G's origin). Frames:
+//   frame t−1: w_prev = −v_S·dt (points were there), shear_prev
+//   frame t:   w_now = 0 (points at their reference positions, where v is evaluated), shear_now
+// so that the contact-centroid displacement is exactly mean(v_S)·dt and, per proxy mode,
+// velocity: shear = v_S / c_velocity (both frames); displacement: shear_now − shear_prev =
+// v_S·dt / c_displacement. v_S is the tangential (x, y) part of R_GSᵀ(ω × q_G + t) at the contact
+// points q_G = R_GS q_S + p_GS, with q_S exactly as ContactDetectorRef builds them.
+struct RigidContactScene {
+  Eigen::Matrix3d R_GS = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_GS = Eigen::Vector3d::Zero();
+  Eigen::Vector3d contact_centre_G = Eigen::Vector3d::Zero();
+  double radius_m = 4e-3;
+  double peak_fz = 0.1;
+  Eigen::Vector3d omega_G = Eigen::Vector3d::Zero();
+  Eigen::Vector3d t_G = Eigen::Vector3d::Zero();
+  double dt = 1.0 / 120.0;
+};
+struct SyntheticSensorFrames {
+  dsp::ScalarField fz;                                    // Q16
+  dsp::GridMask valid;                                    // all valid
+  dsp::VectorField w_prev, w_now, shear_prev, shear_now;  // Q16
+  std::vector<PointSample> points_G;  // contact points and tangential rigid velocities, in G
+};
+SyntheticSensorFrames render_rigid_contact(const dsp::Calibration& cal,
+                                           const RigidContactScene& scene);
+
+}  // namespace tacse3::dsp_ref

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 dsp: validation of the back-end calibration ranges.
+#include "tacse3/dsp/calibration.hpp"
+
+#include <cmath>
+
+namespace tacse3::dsp {
+namespace {
+
+// Closed range check that also rejects NaN and infinities (NaN fails every comparison).
+bool in_range(double v, double lo, double hi) noexcept {
+  return std::isfinite(v) && v >= lo && v <= hi;
+}
+// Half-open (lo, hi]: strictly positive quantities.
+bool in_range_open_lo(double v, double lo, double hi) noexcept {
+  return std::isfinite(v) && v > lo && v <= hi;
+}
+
+}  // namespace
+
+Status validate(const Calibration& c) noexcept {
+  bool ok = true;
+  ok = ok && in_range(c.pixel_pitch_m, 1e-6, 2e-4);
+  ok = ok && in_range(c.pixel_aspect_y, 0.25, 4.0);
+  ok = ok && in_range(c.normal_gain_density, 0.0, 1e4);
+  ok = ok && in_range(c.normal_gain_divergence, 0.0, 1e4);
+  ok = ok && in_range(c.shear_gain_d, 0.0, 1e4);
+  ok = ok && in_range(c.shear_gain_r, 0.0, 1e4);
+  ok = ok && in_range(c.shear_gain_k, 0.0, 1e4);
+  ok = ok && in_range_open_lo(c.contact_tau_on, 0.0, 1e4);
+  ok = ok && in_range(c.contact_tau_off, 0.0, 1e4) && c.contact_tau_off <= c.contact_tau_on;
+  ok = ok && c.contact_min_area_cells >= 1 && c.contact_min_area_cells <= kGridCount;
+  ok = ok && in_range(c.height_gain_m, 0.0, 1.0);
+  ok = ok && in_range(c.height_max_m, 0.0, 1e-2);
+  ok = ok && (c.velocity_proxy == VelocityProxy::kVelocity ||
+              c.velocity_proxy == VelocityProxy::kDisplacement);
+  ok = ok && in_range_open_lo(c.c_velocity, 0.0, 100.0);
+  ok = ok && in_range_open_lo(c.c_displacement, 0.0, 1.0);
+  ok = ok && in_range(c.max_mask_change, 0.0, 1.0);
+  for (int a = 0; a < 3; ++a) {
+    ok = ok && in_range(c.rotation_scale[static_cast<std::size_t>(a)], 0.0, 100.0);
+    ok = ok && in_range(c.translation_scale[static_cast<std::size_t>(a)], 0.0, 100.0);
+  }
+  ok = ok && c.moving_average_length >= 1 && c.moving_average_length <= kMaxMovingAverage;
+  ok = ok && in_range(c.solve_lambda_rel, 0.0, 1.0);
+  ok = ok && in_range(c.solve_lever_floor_m, 0.0, 1e-2);
+  ok =
+      ok && std::isfinite(c.solve_rcond_min) && c.solve_rcond_min >= 0.0 && c.solve_rcond_min < 1.0;
+  return ok ? Status::kOk : Status::kBadCalibration;
+}
+
+}  // namespace tacse3::dsp

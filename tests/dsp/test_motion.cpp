@@ -1,0 +1,392 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tests: per-sensor motion: moments vs brute-force stacked least squares, centroid
+// translation vs analytic motion, onset/loss/area-change rules, proxy modes, degenerate contacts.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+
+#include "tacse3/dsp/contact.hpp"
+#include "tacse3/dsp/fixed.hpp"
+#include "tacse3/dsp/motion.hpp"
+#include "tacse3/dsp_ref/motion_ref.hpp"
+
+namespace tacse3::dsp {
+namespace {
+
+using dsp_ref::RigidContactScene;
+using dsp_ref::SyntheticSensorFrames;
+constexpr double kDt = 1.0 / 120.0;
+
+// Runs frame t−1 and frame t of a synthetic scene through ContactDetector + MotionEstimator.
+struct Runner {
+  Calibration cal;
+  std::unique_ptr<ContactDetector> det = std::make_unique<ContactDetector>();
+  std::unique_ptr<MotionEstimator> me = std::make_unique<MotionEstimator>();
+  std::unique_ptr<ContactSet> cs = std::make_unique<ContactSet>();
+  explicit Runner(const Calibration& c) : cal(c) {
+    EXPECT_EQ(det->configure(cal), Status::kOk);
+    EXPECT_EQ(me->configure(cal), Status::kOk);
+  }
+  SensorMotion frame(const ScalarField& fz, const VectorField& w, const VectorField& shear,
+                     double dt = kDt) {
+    GridMask valid;
+    valid.fill(1);
+    det->detect(fz, w, valid, *cs);
+    SensorMotion out;
+    EXPECT_EQ(me->update(*cs, shear, dt, out), Status::kOk);
+    return out;
+  }
+  SensorMotion pair(const SyntheticSensorFrames& f) {
+    frame(f.fz, f.w_prev, f.shear_prev);
+    return frame(f.fz, f.w_now, f.shear_now);
+  }
+};
+
+void expect_finite(const SensorMotion& m) {
+  EXPECT_TRUE(m.omega.allFinite());
+  EXPECT_TRUE(m.translation.allFinite());
+  EXPECT_TRUE(m.centroid_m.allFinite());
+  EXPECT_TRUE(m.solve.x.allFinite());
+}
+
+TEST(Motion, MomentNormalEquationsMatchBruteForceStackedLeastSquares) {
+  std::mt19937 rng(40);
+  std::uniform_real_distribution<double> pos(-12e-3, 12e-3), z(0.0, 1e-3), v(-2.0, 2.0);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int trial = 0; trial < 8; ++trial) {
+    // A random contact set, written directly (the detector is tested elsewhere).
+    auto cs = std::make_unique<ContactSet>();
+    auto shear = std::make_unique<VectorField>();
+    std::vector<dsp_ref::PointSample> pts;
+    const Calibration cal;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+      if (std::uniform_int_distribution<int>(0, 3)(rng) != 0) continue;
+      cs->mask.v[i] = 1;
+      cs->x_nm.v[i] = static_cast<std::int32_t>(std::lround(pos(rng) * 1e9));
+      cs->y_nm.v[i] = static_cast<std::int32_t>(std::lround(pos(rng) * 1e9));
+      cs->z_nm.v[i] = static_cast<std::int32_t>(std::lround(z(rng) * 1e9));
+      shear->x.v[i] = to_q32<16>(v(rng));
+      shear->y.v[i] = to_q32<16>(v(rng));
+      dsp_ref::PointSample s;
+      s.q = Eigen::Vector3d(cs->x_nm.v[i], cs->y_nm.v[i], cs->z_nm.v[i]) * 1e-9;
+      s.v = cal.c_velocity *
+            Eigen::Vector3d(from_q<16>(shear->x.v[i]), from_q<16>(shear->y.v[i]), 0.0);
+      pts.push_back(s);
+    }
+    MotionEstimator me;
+    SensorMotion out;
+    ASSERT_EQ(me.update(*cs, *shear, kDt, out), Status::kOk);
+    ASSERT_EQ(out.points, static_cast<int>(pts.size()));
+    const MomentSums ms = to_metric(out.moments, out.proxy_scale);
+    // Any rigid transform: random rotation (incl. the mirrored right-pad mount) and offset.
+    Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
+    q.normalize();
+    Eigen::Matrix3d R = q.toRotationMatrix();
+    if (trial % 2 == 1) R = R * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+    const Eigen::Vector3d p = Eigen::Vector3d(n(rng), n(rng), n(rng)) * 0.02;
+    Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
+    add_normal_equations(rigid_transform(ms, R, p), AtA, Atb);
+    std::vector<dsp_ref::PointSample> g = pts;
+    for (auto& s : g) {
+      s.q = R * s.q + p;
+      s.v = R * s.v;
+      s.normal = R * s.normal;
+    }
+    const dsp_ref::StackedSystem sys = dsp_ref::stack_shear_rows(g);
+    const Eigen::Matrix3d AtA_ref = sys.A.transpose() * sys.A;
+    const Eigen::Vector3d Atb_ref = sys.A.transpose() * sys.b;
+    EXPECT_LT((AtA - AtA_ref).cwiseAbs().maxCoeff(), 1e-13 * AtA_ref.cwiseAbs().maxCoeff());
+    EXPECT_LT((Atb - Atb_ref).cwiseAbs().maxCoeff(), 1e-13 * Atb_ref.cwiseAbs().maxCoeff());
+    // The same least-squares solution (same Tikhonov λ) from a QR of the stacked rows.
+    Solve3Options opt;
+    opt.lambda_rel = 1e-6;
+    opt.lambda_abs = 0.0;
+    const Solve3Result r = solve3(AtA, Atb, opt);
+    const Eigen::Vector3d w_ref = dsp_ref::solve_stacked(sys, r.lambda);
+    EXPECT_LT((r.x - w_ref).norm(), 1e-9 * w_ref.norm());
+    // Sensor frame: the paper's own rows [0, z, −y], [−z, 0, x] (identity transform).
+    Eigen::Matrix3d AtA_s = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d Atb_s = Eigen::Vector3d::Zero();
+    add_normal_equations(ms, AtA_s, Atb_s);
+    const dsp_ref::StackedSystem sys_s = dsp_ref::stack_shear_rows(pts);
+    EXPECT_LT((AtA_s - sys_s.A.transpose() * sys_s.A).cwiseAbs().maxCoeff(),
+              1e-12 * AtA_s.cwiseAbs().maxCoeff());
+    EXPECT_EQ(sys_s.A(0, 0), 0.0);
+    EXPECT_DOUBLE_EQ(sys_s.A(0, 1), pts[0].q.z());
+    EXPECT_DOUBLE_EQ(sys_s.A(0, 2), -pts[0].q.y());
+    EXPECT_DOUBLE_EQ(sys_s.A(1, 0), -pts[0].q.z());
+    EXPECT_DOUBLE_EQ(sys_s.A(1, 2), pts[0].q.x());
+  }
+}
+
+TEST(Motion, ExtremeMomentsAreExactInInt64) {
+  auto cs = std::make_unique<ContactSet>();
+  auto shear = std::make_unique<VectorField>();
+  cs->mask.fill(1);
+  cs->x_nm.fill(kMaxPointNm);
+  cs->y_nm.fill(-kMaxPointNm);
+  cs->z_nm.fill(kQ32MaxPos);  // re-clamped to 2^24 − 1 by the motion stage
+  shear->x.fill(kQ32MaxPos);  // clamped to ±kMaxProxyQ16
+  shear->y.fill(kQ32MaxNeg);
+  MotionEstimator me;
+  SensorMotion out;
+  ASSERT_EQ(me.update(*cs, *shear, kDt, out), Status::kOk);
+  const std::int64_t n = kGridCount, x = kMaxPointNm, z = (1 << 24) - 1, v = kMaxProxyQ16;
+  EXPECT_EQ(out.moments.n, n);
+  EXPECT_EQ(out.moments.sxx, n * x * x);
+  EXPECT_EQ(out.moments.sxy, -n * x * x);
+  EXPECT_EQ(out.moments.szz, n * z * z);
+  EXPECT_EQ(out.moments.sx_vy, -n * x * v);
+  EXPECT_EQ(out.moments.sz_vx, n * z * v);
+  expect_finite(out);
+}
+
+TEST(Motion, CentroidTranslationMatchesAnalyticMotion) {
+  for (VelocityProxy mode : {VelocityProxy::kVelocity, VelocityProxy::kDisplacement}) {
+    Calibration cal;
+    cal.velocity_proxy = mode;
+    RigidContactScene sc;
+    sc.contact_centre_G = Eigen::Vector3d(3e-3, -2e-3, 0.0);
+    sc.t_G = Eigen::Vector3d(3e-3, -2e-3, 0.0);  // m/s
+    sc.omega_G = Eigen::Vector3d(0.0, 0.0, 0.4);
+    const SyntheticSensorFrames f = dsp_ref::render_rigid_contact(cal, sc);
+    Runner run(cal);
+    const SensorMotion m = run.pair(f);
+    ASSERT_TRUE(m.translation_valid);
+    EXPECT_EQ(m.translation_source, TranslationSource::kCentroid);
+    EXPECT_EQ(m.mask_change, 0.0);
+    // Stick: every contact point moved by v(q)·dt, so the centroid moved by v(centroid)·dt.
+    const Eigen::Vector3d c = dsp_ref::centroid(f.points_G);
+    Eigen::Vector3d expect = sc.omega_G.cross(c) + sc.t_G;
+    expect.z() = 0.0;
+    // Positions are Q16 working px (≤ 2^-17 · 150 µm = 1.1 nm per point) and 1 nm integers:
+    // ≤ ~2 nm per frame / dt = 2.4e-7 m/s.
+    EXPECT_LT((m.translation - expect).norm(), 3e-7) << static_cast<int>(mode);
+    EXPECT_EQ(m.translation.z(), 0.0);
+  }
+}
+
+TEST(Motion, RotationFromRigidShearMatchesTruthAndReference) {
+  for (VelocityProxy mode : {VelocityProxy::kVelocity, VelocityProxy::kDisplacement}) {
+    Calibration cal;
+    cal.velocity_proxy = mode;
+    cal.solve_lambda_rel = 0.0;
+    cal.solve_lever_floor_m = 0.0;
+    RigidContactScene sc;
+    sc.contact_centre_G = Eigen::Vector3d(2e-3, 1e-3, 0.0);
+    sc.radius_m = 5e-3;
+    sc.peak_fz = 0.15;
+    sc.omega_G = Eigen::Vector3d(0.2, -0.3, 0.5);  // about the pad origin, t = 0
+    const SyntheticSensorFrames f = dsp_ref::render_rigid_contact(cal, sc);
+    Runner run(cal);
+    const SensorMotion m = run.pair(f);
+    ASSERT_TRUE(m.contact);
+    EXPECT_TRUE(m.rotation_valid);
+    EXPECT_EQ(m.solve.rank, 3);
+    // Rigid data with t = 0 is fitted exactly by the own-frame shear-only model; what is left
+    // is Q16 shear quantisation (≤ 2^-17 · c_v per point) amplified by the small z lever.
+    EXPECT_LT((m.omega - sc.omega_G).norm(), 1e-4 * sc.omega_G.norm()) << static_cast<int>(mode);
+    EXPECT_LT(std::abs(m.omega.z() - sc.omega_G.z()), 1e-5);
+
+    // Double reference, same rules, same λ (= 0 here).
+    dsp_ref::ContactDetectorRef rdet(cal);
+    dsp_ref::MotionRef rme(cal);
+    auto shear_d = [](const VectorField& s, bool x) {
+      std::vector<double> v(static_cast<std::size_t>(kGridCount));
+      for (std::size_t i = 0; i < v.size(); ++i) v[i] = from_q<16>(x ? s.x.v[i] : s.y.v[i]);
+      return v;
+    };
+    std::vector<double> fz(static_cast<std::size_t>(kGridCount));
+    for (std::size_t i = 0; i < fz.size(); ++i) fz[i] = from_q<16>(f.fz.v[i]);
+    rme.update(rdet.detect(fz, f.w_prev, f.valid), shear_d(f.shear_prev, true),
+               shear_d(f.shear_prev, false), kDt);
+    const dsp_ref::SensorMotionRef r =
+        rme.update(rdet.detect(fz, f.w_now, f.valid), shear_d(f.shear_now, true),
+                   shear_d(f.shear_now, false), kDt);
+    EXPECT_EQ(r.points, m.points);
+    // Fixed path vs double of the same Q16 inputs: only z (Q16 filter → nm) and nm rounding.
+    EXPECT_LT((m.omega - r.omega).norm(), 2e-5 * r.omega.norm());
+    // ≤ 0.5 nm position rounding per point and frame: ≤ 1 nm / dt = 1.2e-7 m/s.
+    EXPECT_LT((m.translation - r.translation).norm(), 1.2e-7);
+  }
+}
+
+TEST(Motion, DefaultRegularisationBiasIsSmall) {
+  const Calibration cal;  // λ_rel = 1e-6, lever floor 10 µm
+  RigidContactScene sc;
+  sc.radius_m = 5e-3;
+  sc.peak_fz = 0.15;  // z up to 0.75 mm
+  sc.omega_G = Eigen::Vector3d(0.2, -0.3, 0.5);
+  Runner run(cal);
+  const SensorMotion m = run.pair(dsp_ref::render_rigid_contact(cal, sc));
+  // λ ≈ N · (10 µm)² against Σ z² ≈ N · (0.3 mm)²: ~0.1 % shrinkage of ω_x, ω_y.
+  EXPECT_LT((m.omega - sc.omega_G).norm(), 1e-3 * sc.omega_G.norm());
+  EXPECT_TRUE(m.rotation_valid);
+}
+
+TEST(Motion, DisplacementModeNeedsOnePreviousFrame) {
+  Calibration cal;
+  cal.velocity_proxy = VelocityProxy::kDisplacement;
+  RigidContactScene sc;
+  sc.omega_G = Eigen::Vector3d(0.0, 0.0, 0.5);
+  const SyntheticSensorFrames f = dsp_ref::render_rigid_contact(cal, sc);
+  Runner run(cal);
+  const SensorMotion first = run.frame(f.fz, f.w_prev, f.shear_prev);
+  EXPECT_TRUE(first.contact);
+  EXPECT_FALSE(first.proxy_valid);
+  EXPECT_FALSE(first.rotation_valid);
+  EXPECT_EQ(first.omega, Eigen::Vector3d::Zero());
+  const SensorMotion second = run.frame(f.fz, f.w_now, f.shear_now);
+  EXPECT_TRUE(second.proxy_valid);
+  EXPECT_NEAR(second.omega.z(), 0.5, 1e-4);
+  // After reset the first frame is again without proxy.
+  run.me->reset();
+  EXPECT_FALSE(run.frame(f.fz, f.w_now, f.shear_now).proxy_valid);
+}
+
+TEST(Motion, OnsetAndLossGiveNoTranslationAndNoNan) {
+  const Calibration cal;
+  RigidContactScene sc;
+  sc.t_G = Eigen::Vector3d(5e-3, 0.0, 0.0);
+  const SyntheticSensorFrames f = dsp_ref::render_rigid_contact(cal, sc);
+  Runner run(cal);
+  auto empty = std::make_unique<SyntheticSensorFrames>();
+  // Nothing → nothing.
+  SensorMotion m = run.frame(empty->fz, empty->w_now, empty->shear_now);
+  EXPECT_FALSE(m.contact);
+  EXPECT_FALSE(m.rotation_valid);
+  EXPECT_FALSE(m.translation_valid);
+  EXPECT_EQ(m.omega, Eigen::Vector3d::Zero());
+  EXPECT_EQ(m.translation, Eigen::Vector3d::Zero());
+  EXPECT_FALSE(m.solve.valid);
+  expect_finite(m);
+  // Onset: contact appears. The centroid jumps from "nowhere": no translation this frame.
+  m = run.frame(f.fz, f.w_now, f.shear_now);
+  EXPECT_TRUE(m.contact);
+  EXPECT_FALSE(m.translation_valid);
+  EXPECT_EQ(m.translation_source, TranslationSource::kNone);
+  EXPECT_EQ(m.translation, Eigen::Vector3d::Zero());
+  EXPECT_EQ(m.mask_change, 1.0);
+  // Loss: contact disappears.
+  m = run.frame(empty->fz, empty->w_now, empty->shear_now);
+  EXPECT_FALSE(m.contact);
+  EXPECT_FALSE(m.translation_valid);
+  EXPECT_EQ(m.translation, Eigen::Vector3d::Zero());
+  expect_finite(m);
+}
+
+TEST(Motion, LargeAreaChangeUsesCommonPointsInsteadOfTheCentroidJump) {
+  const Calibration cal;
+  const Eigen::Vector3d v(4e-3, 1e-3, 0.0);  // object translation, m/s
+  // Frame t−1: small patch; frame t: a much larger patch grown towards +x (pressing harder on
+  // a tilted object). Every material point moves by v·dt.
+  RigidContactScene small;
+  small.contact_centre_G = Eigen::Vector3d(-2e-3, 0.0, 0.0);
+  small.radius_m = 3e-3;
+  small.t_G = v;
+  RigidContactScene big = small;
+  big.contact_centre_G = Eigen::Vector3d(1e-3, 0.0, 0.0);
+  big.radius_m = 5e-3;
+  const SyntheticSensorFrames fs = dsp_ref::render_rigid_contact(cal, small);
+  const SyntheticSensorFrames fb = dsp_ref::render_rigid_contact(cal, big);
+  Runner run(cal);
+  const SensorMotion m0 = run.frame(fs.fz, fb.w_prev, fs.shear_now);
+  const SensorMotion m1 = run.frame(fb.fz, fb.w_now, fb.shear_now);
+  ASSERT_GT(m1.mask_change, cal.max_mask_change);
+  EXPECT_TRUE(m1.translation_valid);
+  EXPECT_EQ(m1.translation_source, TranslationSource::kCommonPoints);
+  EXPECT_LT((m1.translation - v).norm(), 3e-7);
+  // What the plain centroid difference would have reported: a spike of ~0.3 m/s.
+  const double naive = (m1.centroid_m.x() - m0.centroid_m.x()) / kDt;
+  EXPECT_GT(std::abs(naive - v.x()), 0.1);
+  // A small change (a few edge cells) keeps the paper's mask-centroid rule.
+  RigidContactScene bigger = big;
+  bigger.radius_m = 5.2e-3;
+  const SyntheticSensorFrames fg = dsp_ref::render_rigid_contact(cal, bigger);
+  const SensorMotion m2 = run.frame(fg.fz, fb.w_now, fg.shear_now);
+  EXPECT_LE(m2.mask_change, cal.max_mask_change);
+  EXPECT_GT(m2.mask_change, 0.0);
+  EXPECT_EQ(m2.translation_source, TranslationSource::kCentroid);
+}
+
+TEST(Motion, DegenerateContactsAreFlaggedAndFinite) {
+  // Flat contact (z ≡ 0): ω_x, ω_y unobservable from shear, ω_z still exact.
+  Calibration cal;
+  cal.height_gain_m = 0.0;
+  RigidContactScene sc;
+  sc.omega_G = Eigen::Vector3d(0.3, 0.3, 0.5);
+  {
+    Runner run(cal);
+    const SensorMotion m = run.pair(dsp_ref::render_rigid_contact(cal, sc));
+    EXPECT_FALSE(m.rotation_valid);
+    EXPECT_EQ(m.solve.rank, 1);
+    EXPECT_NEAR(m.omega.z(), 0.5, 1e-4);
+    // With z = 0, Aᵀb has no ω_x, ω_y component: regularised to exactly 0.
+    EXPECT_EQ(m.omega.x(), 0.0);
+    EXPECT_EQ(m.omega.y(), 0.0);
+    expect_finite(m);
+  }
+  // A single contact point (min area 1): two equations for three unknowns.
+  Calibration one;
+  one.contact_min_area_cells = 1;
+  {
+    Runner run(one);
+    auto f = std::make_unique<SyntheticSensorFrames>(dsp_ref::render_rigid_contact(one, sc));
+    f->fz.fill(0);
+    f->fz(20, 15) = to_q32<16>(1.0);  // the filter spreads it; keep only the centre above τ_on
+    Calibration c = one;
+    c.contact_tau_on = c.contact_tau_off = 0.2;
+    ASSERT_EQ(run.det->configure(c), Status::kOk);
+    const SensorMotion m = run.pair(*f);
+    EXPECT_EQ(m.points, 1);
+    EXPECT_FALSE(m.rotation_valid);
+    EXPECT_LE(m.solve.rank, 2);
+    expect_finite(m);
+  }
+  // Collinear points on a flat strip: rank 1.
+  {
+    Runner run(cal);
+    auto f = std::make_unique<SyntheticSensorFrames>(dsp_ref::render_rigid_contact(cal, sc));
+    f->fz.fill(0);
+    for (int gx = 5; gx < 35; ++gx) f->fz(gx, 15) = to_q32<16>(0.05);  // filter 0.025 on it
+    const SensorMotion m = run.pair(*f);
+    EXPECT_EQ(m.points, 28);
+    EXPECT_FALSE(m.rotation_valid);
+    EXPECT_EQ(m.solve.rank, 1);
+    expect_finite(m);
+  }
+}
+
+TEST(Motion, BadDtIsRejectedAndLeavesStateUntouched) {
+  const Calibration cal;
+  RigidContactScene sc;
+  sc.t_G = Eigen::Vector3d(2e-3, 0.0, 0.0);
+  const SyntheticSensorFrames f = dsp_ref::render_rigid_contact(cal, sc);
+  Runner a(cal), b(cal);
+  a.frame(f.fz, f.w_prev, f.shear_prev);
+  b.frame(f.fz, f.w_prev, f.shear_prev);
+  GridMask valid;
+  valid.fill(1);
+  for (double dt : {std::numeric_limits<double>::quiet_NaN(), 0.0, -kDt, 2.0,
+                    std::numeric_limits<double>::infinity()}) {
+    b.det->detect(f.fz, f.w_now, valid, *b.cs);
+    SensorMotion out;
+    out.omega.setConstant(7.0);
+    EXPECT_EQ(b.me->update(*b.cs, f.shear_now, dt, out), Status::kBadArgument);
+    EXPECT_FALSE(out.contact);
+    EXPECT_EQ(out.omega, Eigen::Vector3d::Zero());
+  }
+  const SensorMotion ma = a.frame(f.fz, f.w_now, f.shear_now);
+  const SensorMotion mb = b.frame(f.fz, f.w_now, f.shear_now);
+  EXPECT_EQ(ma.translation, mb.translation);
+  EXPECT_EQ(ma.omega, mb.omega);
+  EXPECT_TRUE(mb.translation_valid);
+}
+
+}  // namespace
+}  // namespace tacse3::dsp
