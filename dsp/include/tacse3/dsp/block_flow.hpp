@@ -1,0 +1,244 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 dsp: fixed-point pyramidal block flow with keyframe chaining (paper Eq. (dense_flow)).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "tacse3/dsp/pyramid.hpp"
+#include "tacse3/dsp/types.hpp"
+
+namespace tacse3::dsp {
+
+// Square matching window, in pixels of the pyramid level it is applied to. 8 x 8 working px
+// (16 x 16 sensor px) centred on a grid point: neighbouring windows overlap by half.
+inline constexpr int kFlowWindow = 8;
+inline constexpr int kFlowWindowPixels = kFlowWindow * kFlowWindow;  // 64 = 2^6
+
+// Grid of level l: the level-0 grid decimated by 2^l. Point j of level l sits at level-l
+// coordinate 4 j + 1.5 and stands for the 2^l x 2^l block of level-0 points it covers.
+constexpr int flow_grid_width(int level) noexcept {
+  return kGridWidth >> level;
+}
+constexpr int flow_grid_height(int level) noexcept {
+  return kGridHeight >> level;
+}
+constexpr int flow_grid_count(int level) noexcept {
+  return flow_grid_width(level) * flow_grid_height(level);
+}
+constexpr int flow_grid_offset(int level) noexcept {
+  int off = 0;
+  for (int l = 0; l < level; ++l) off += flow_grid_count(l);
+  return off;
+}
+inline constexpr int kFlowModelCount = flow_grid_offset(kMaxPyramidLevels);  // 1200+300+70
+
+// Tuning of the block flow. Lengths are in pixels of the pyramid level they act on unless
+// they say "working px" (level 0). Converted to integers once, in configure().
+struct BlockFlowConfig {
+  int pyramid_levels = 3;     // 1..kMaxPyramidLevels; 3 levels recover >= 10 working px jumps
+  int fine_iterations = 4;    // max Gauss-Newton iterations at level 0 (1..16)
+  int coarse_iterations = 8;  // max iterations at each coarse level (1..16)
+  // The coarse levels run when at least this many trackable windows fail at level 0 from the
+  // warm start (0 = every frame). 0..1200.
+  int coarse_trigger = 3;
+  // A new keyframe is taken when some tracked point has moved this far (working px) from the
+  // current keyframe. 0 disables chaining (everything is tracked against the tare frame).
+  double keyframe_switch_px = 2.0;
+  // A keyframe switch needs at least this fraction of the keyframe's trackable points valid in
+  // the frame (never switch onto a dark, saturated or occluded frame).
+  double keyframe_min_valid_fraction = 0.5;
+  // Texture: smallest eigenvalue of the zero-mean structure tensor per pixel, expressed as the
+  // RMS luma gradient (luma levels per pixel) along the weakest direction.
+  double min_texture = 1.0;
+  // Conditioning: smallest / largest eigenvalue of the zero-mean structure tensor.
+  double min_eigen_ratio = 0.02;
+  // Match quality: zero-mean residual energy / zero-mean template energy after the last
+  // iteration (0 = perfect match; an unrelated or blank frame gives ~1 or more).
+  double max_residual_ratio = 0.15;
+  double max_step_px = 2.0;        // per-iteration step clamp
+  double converged_step_px = 0.1;  // the last step must be below this for a valid point
+  // At a keyframe switch, points whose direct match against the tare frame agrees with the
+  // chained displacement within this tolerance (working px) take the direct value, which
+  // resets the drift of the chain (see BlockFlow::re_anchor()). 0 disables re-anchoring.
+  double reanchor_tolerance_px = 0.5;
+};
+
+// Validates a config (ranges above, finite values). kBadArgument on failure.
+Status validate(const BlockFlowConfig& config) noexcept;
+
+// Template of one window, packed contiguously at keyframe time so that the per-iteration loop
+// runs over 64 consecutive samples: T (U8.2) and its central-difference gradients
+// gx = T(x+1) - T(x-1), gy = T(y+1) - T(y-1) (int16, |.| <= 1020), row-major 8x8.
+struct FlowWindowTemplate {
+  alignas(16) std::array<std::int16_t, kFlowWindowPixels> t{};
+  alignas(16) std::array<std::int16_t, kFlowWindowPixels> gx{};
+  alignas(16) std::array<std::int16_t, kFlowWindowPixels> gy{};
+};
+
+// Per-window model, precomputed when a keyframe is taken (inverse-compositional LK: the
+// template, its gradients and the inverse structure tensor stay fixed until the next keyframe).
+// Formats are listed at the top of block_flow.cpp and in docs/dsp-front.md.
+struct FlowWindowModel {
+  // Block-floating-point inverse of the zero-mean, gain-eliminated structure tensor H64:
+  // H64^-1 = [inv_a inv_b; inv_b inv_c] * 2^-(shift + 12). Mantissas |.| < 2^22.
+  std::int32_t inv_a = 0;
+  std::int32_t inv_b = 0;
+  std::int32_t inv_c = 0;
+  std::int32_t gsum_x = 0;  // sum of gx over the window (|.| <= 64 * 1020)
+  std::int32_t gsum_y = 0;
+  std::int32_t tsum = 0;     // sum of T over the window (<= 64 * 1020)
+  std::int32_t gain_qx = 0;  // gain coupling k / e (Q16, |.| <= 2^22)
+  std::int32_t gain_qy = 0;
+  std::int64_t template_energy = 0;  // 64 sum (2T)^2 - (sum 2T)^2 (U8.3 units): < 2^36
+  // Bilinear-smoothing compensation: zero-mean projections of the template's second differences
+  // onto gx, gy and T: {(gx, Txx), (gy, Txx), (T, Txx), (gx, Tyy), (gy, Tyy), (T, Tyy)} with
+  // (a, Txx) = 64 sum a Txx - (sum a)(sum Txx); |.| < 2^35.
+  std::array<std::int64_t, 6> curvature{};
+  // Level 0 only: measurement-point moments P_x, P_y (row-major 2x2, Q16 px), see
+  // BlockFlow::write_output(). |.| < 2^20.
+  std::array<std::int32_t, 4> moment_x{};
+  std::array<std::int32_t, 4> moment_y{};
+  std::int16_t ox = 0;  // window origin (top-left pixel) in the keyframe plane of its level
+  std::int16_t oy = 0;
+  std::int8_t shift = 0;  // right shift turning M * b64 into a Q16 step
+  std::uint8_t valid = 0;
+};
+
+// Dense block flow on the 40x30 grid by windowed least squares (Eq. (dense_flow)), solved by
+// zero-mean inverse-compositional Lucas-Kanade with a local gain and offset per window, coarse
+// to fine over a [1 3 3 1] pyramid, warm-started from the previous frame, against an adaptive
+// keyframe chained back to the tare (undeformed) frame.
+//
+// The object is large (~1.1 MB, mostly the packed window templates) and allocation-free;
+// construct it once (static storage or one allocation at start-up).
+class BlockFlow {
+ public:
+  BlockFlow() noexcept;
+  // An invalid config falls back to the defaults (check with validate() first).
+  explicit BlockFlow(const BlockFlowConfig& config) noexcept;
+
+  // Replaces the config. Drops the reference (the next track() is an implicit tare), because
+  // the window models depend on the thresholds. On error nothing changes.
+  Status configure(const BlockFlowConfig& config) noexcept;
+  const BlockFlowConfig& config() const noexcept { return config_; }
+
+  // Reference := frame; displacement := 0; keyframe := frame; switch count := 0.
+  void tare(const WorkImage& frame) noexcept;
+
+  // Tracks one frame. `displacement`: displacement of each grid material point relative to the
+  // tare frame, Q16 working px. `valid`: 1 where the point was tracked in this frame (window
+  // inside the image, well-conditioned, converged, small residual, consistent with its
+  // neighbours). Invalid points hold their previous displacement. The first call without a
+  // reference is an implicit tare (all zeros; valid = the points trackable in that frame).
+  void track(const WorkImage& frame, VectorField& displacement, GridMask& valid) noexcept;
+
+  bool has_reference() const noexcept { return has_reference_; }
+  std::uint32_t keyframe_switches() const noexcept { return keyframe_switches_; }  // since tare
+  std::uint32_t frames_since_keyframe() const noexcept { return frames_since_keyframe_; }
+  bool last_frame_was_keyframe() const noexcept { return last_frame_was_keyframe_; }
+  int valid_count() const noexcept { return valid_count_; }                    // last track()
+  int keyframe_valid_count() const noexcept { return keyframe_valid_count_; }  // level 0
+  // Displacement of each material point at the moment the current keyframe was taken (Q16).
+  const VectorField& keyframe_displacement() const noexcept { return key_displacement_; }
+  // Translation of each level-0 window since the keyframe (Q16 working px).
+  const VectorField& flow_from_keyframe() const noexcept { return window_flow_; }
+
+  // Stage access for tests and tools.
+  const ImagePyramid& keyframe_pyramid() const noexcept {
+    return pyramid_[static_cast<std::size_t>(key_index_)];
+  }
+  const FlowWindowModel& window_model(int level, int index) const noexcept {
+    return models_[static_cast<std::size_t>(flow_grid_offset(level) + index)];
+  }
+  const FlowWindowTemplate& window_template(int level, int index) const noexcept {
+    return templates_[static_cast<std::size_t>(flow_grid_offset(level) + index)];
+  }
+
+ private:
+  struct WindowResult {
+    std::int32_t ux;  // Q16 level px
+    std::int32_t uy;
+    bool valid;
+    bool outside;  // failed because the window left the image
+  };
+  struct JacobianStencil {  // see write_output()
+    std::int16_t a;
+    std::int16_t b;
+    std::int32_t recip;
+  };
+  struct Thresholds {  // integer forms of the config, set in configure()
+    std::int64_t min_eigen_h64 = 0;
+    std::int64_t eigen_ratio_kappa_q16 = 0;
+    std::int64_t residual_ratio_q8 = 0;
+    std::int32_t max_step_q16 = 0;
+    std::int32_t converged_q16 = 0;
+    std::int64_t keyframe_switch_sq_q32 = 0;
+    std::int64_t keyframe_min_valid_q16 = 0;
+    std::int32_t reanchor_tolerance_q16 = 0;
+  };
+
+  void take_keyframe() noexcept;
+  void build_models(int level) noexcept;
+  WindowResult track_window(int level, int index, std::int32_t ux, std::int32_t uy,
+                            int iterations) const noexcept;
+  void coarse_to_fine() noexcept;
+  void write_output(VectorField& displacement, GridMask& valid) noexcept;
+  void maybe_switch_keyframe() noexcept;
+  void re_anchor() noexcept;
+  void upsample_correction(int level) noexcept;
+  int track_fine(bool retry) noexcept;
+  bool fit_from_neighbours(int gx, int gy, std::int32_t& ux, std::int32_t& uy) const noexcept;
+
+  BlockFlowConfig config_{};
+  Thresholds th_{};
+  bool has_reference_ = false;
+  int key_index_ = 2;  // pyramid_ slot of the keyframe (2 = the tare frame itself)
+  int cur_index_ = 0;  // pyramid_ slot that receives new frames (0 or 1, never the keyframe)
+  std::uint32_t keyframe_switches_ = 0;
+  std::uint32_t frames_since_keyframe_ = 0;
+  bool last_frame_was_keyframe_ = false;
+  bool coarse_built_ = false;  // coarse pyramid levels of the current frame exist
+  int valid_count_ = 0;
+  int keyframe_valid_count_ = 0;
+
+  std::array<ImagePyramid, 3> pyramid_{};  // two alternating slots + the tare frame
+  std::array<FlowWindowModel, kFlowModelCount> models_{};
+  std::array<FlowWindowTemplate, kFlowModelCount> templates_{};
+
+  VectorField key_displacement_{};  // D_key: material displacement at the keyframe (Q16)
+  VectorField window_offset_{};     // delta = material position - window centre, keyframe (Q16)
+  VectorField window_flow_{};       // t_w: window translation since the keyframe (Q16)
+  VectorField output_{};            // last output (held for invalid points)
+  GridMask frame_valid_{};
+  GridMask lost_{};  // untracked at the last keyframe switch and not recoverable from neighbours
+  std::array<std::int16_t, kGridCount> window_origin_x_{};  // level-0 window origins
+  std::array<std::int16_t, kGridCount> window_origin_y_{};
+  // write_output() scratch: window-centre flows, flow gradients {dfx/dx, dfy/dx, dfx/dy,
+  // dfy/dy} (Q16) and the difference stencils of the frame.
+  VectorField centre_{};
+  std::array<std::array<std::int32_t, 4>, kGridCount> jacobian_{};
+  std::array<std::array<JacobianStencil, 2>, kGridCount> stencil_{};
+  // re_anchor() scratch.
+  VectorField reanchor_reported_{};
+  VectorField reanchor_chained_{};
+  VectorField reanchor_direct_{};
+  GridMask reanchor_reported_valid_{};
+  GridMask reanchor_chained_lost_{};
+  GridMask reanchor_direct_valid_{};
+  // Coarse-level warm starts and corrections (Q16 working px), per level's own grid.
+  std::array<std::int32_t, kFlowModelCount> warm_x_{};
+  std::array<std::int32_t, kFlowModelCount> warm_y_{};
+  std::array<std::int32_t, kFlowModelCount> corr_x_{};
+  std::array<std::int32_t, kFlowModelCount> corr_y_{};
+  std::array<std::int32_t, kFlowModelCount> up_x_{};  // corrections upsampled from the level above
+  std::array<std::int32_t, kFlowModelCount> up_y_{};
+  // Per-level estimates of the current frame (Q16 working px) and their usable flags.
+  std::array<std::int32_t, kFlowModelCount> flow_x_{};
+  std::array<std::int32_t, kFlowModelCount> flow_y_{};
+  std::array<std::uint8_t, kFlowModelCount> ok_{};
+  std::array<std::uint8_t, kFlowModelCount> scratch_{};
+};
+
+}  // namespace tacse3::dsp

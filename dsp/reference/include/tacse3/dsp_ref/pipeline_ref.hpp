@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 dsp reference: the whole dual-sensor pipeline chained from the double-precision stages.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "tacse3/dsp/pipeline.hpp"
+#include "tacse3/dsp_ref/block_flow_ref.hpp"
+#include "tacse3/dsp_ref/contact_ref.hpp"
+#include "tacse3/dsp_ref/motion_ref.hpp"
+#include "tacse3/dsp_ref/nhhd_ref.hpp"
+#include "tacse3/dsp_ref/smoothing_ref.hpp"
+
+namespace tacse3::dsp_ref {
+
+// One sensor's reference chain: luma → block flow → smoothing → 𝒢 → NHHD → forces → Ω → motion,
+// each stage the double-precision twin of the fixed-point stage with the same configuration.
+// Where a reference stage takes the firmware's Q16 field types as input (force map, contact),
+// the double values are rounded to Q16 (LSB 2^-16 px), far below every tolerance that uses it.
+class SensorPipelineRef {
+ public:
+  SensorPipelineRef(const dsp::PipelineConfig& config, const dsp::Calibration& cal);
+  void tare();
+  // Returns false for a frame the firmware would reject (size/format) — then nothing changes.
+  bool process(const dsp::FrameView& frame, double dt_s, SensorMotionRef& out, bool& degraded);
+
+  const GridVectorD& flow() const { return flow_; }
+  const GridVectorD& smoothed() const { return smoothed_; }
+  const GridScalarD& density() const { return density_; }
+  const GridVectorD& d() const { return d_; }
+  const GridVectorD& r() const { return r_; }
+  const GridVectorD& k() const { return k_; }
+  const std::vector<double>& fz() const { return fz_; }
+  const std::vector<double>& shear_x() const { return shear_x_; }
+  const std::vector<double>& shear_y() const { return shear_y_; }
+
+ private:
+  dsp::PipelineConfig config_;
+  dsp::Calibration cal_;
+  BlockFlowRef flow_stage_;
+  NhhdRef nhhd_stage_;
+  ContactDetectorRef contact_stage_;
+  MotionRef motion_stage_;
+  bool tare_pending_ = true;
+  dsp::WorkImage last_work_{};
+  GridVectorD flow_, smoothed_, d_, r_, k_;
+  GridMaskD flow_valid_, smoothed_valid_;
+  GridScalarD density_;
+  std::vector<double> fz_, shear_x_, shear_y_;
+};
+
+struct DualResultRef {
+  dsp::Vector6d fused = dsp::Vector6d::Zero();  // this frame's fused twist
+  dsp::Vector6d twist = dsp::Vector6d::Zero();  // moving average
+  dsp::Pose pose{};
+  bool rotation_valid = false;
+};
+
+// Both sensors, joint or paper fusion by brute-force stacked least squares in G, the moving
+// average as an explicit window mean and the SE(3) integration of dsp/se3 (already double).
+class DualPipelineRef {
+ public:
+  DualPipelineRef(const dsp::DualConfig& config, const std::array<dsp::Calibration, 2>& cal);
+  void process(const dsp::FrameView* left, const dsp::FrameView* right, std::int64_t t_ns,
+               DualResultRef& out);
+  const SensorPipelineRef& sensor(int i) const { return sensors_[static_cast<std::size_t>(i)]; }
+
+ private:
+  dsp::DualConfig config_;
+  std::array<dsp::Calibration, 2> cal_;
+  std::vector<SensorPipelineRef> sensors_;
+  std::vector<dsp::Vector6d> window_;
+  dsp::Pose pose_{};
+  std::int64_t last_t_ns_ = 0;
+  bool have_last_t_ = false;
+};
+
+}  // namespace tacse3::dsp_ref

@@ -1,0 +1,199 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 dsp reference: the whole dual-sensor pipeline chained from the double-precision stages.
+#include "tacse3/dsp_ref/pipeline_ref.hpp"
+
+#include <cmath>
+
+#include "tacse3/dsp/luma.hpp"
+#include "tacse3/dsp_ref/density_ref.hpp"
+#include "tacse3/dsp_ref/force_map_ref.hpp"
+
+namespace tacse3::dsp_ref {
+
+SensorPipelineRef::SensorPipelineRef(const dsp::PipelineConfig& config, const dsp::Calibration& cal)
+    : config_(config),
+      cal_(cal),
+      flow_stage_(config.flow),
+      nhhd_stage_(config.nhhd),
+      contact_stage_(cal),
+      motion_stage_(cal) {}
+
+void SensorPipelineRef::tare() {
+  if (flow_stage_.has_reference()) {
+    flow_stage_.tare(last_work_);
+    tare_pending_ = false;
+  } else {
+    tare_pending_ = true;
+  }
+  nhhd_stage_.reset();
+  contact_stage_.reset();
+  motion_stage_.reset();
+}
+
+bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, SensorMotionRef& out,
+                                bool& degraded) {
+  out = SensorMotionRef{};
+  degraded = false;
+  // The luma stage is exact integer arithmetic (test_luma holds it against luma_ref), so the
+  // reference starts from the same working image.
+  if (dsp::frame_to_work_image(frame, last_work_) != dsp::Status::kOk) return false;
+  if (tare_pending_) {
+    flow_stage_.tare(last_work_);
+    tare_pending_ = false;
+  }
+  std::vector<std::uint8_t> valid;
+  flow_stage_.track(last_work_, flow_.x, flow_.y, valid);
+  flow_valid_.assign(valid.begin(), valid.end());
+  int tracked = 0;
+  for (auto v : valid) tracked += v != 0 ? 1 : 0;
+
+  smooth_ref(flow_, flow_valid_, config_.smoothing, smoothed_, smoothed_valid_);
+  density_ = gaussian_density_ref(smoothed_, smoothed_valid_, config_.density);
+  nhhd_stage_.decompose(smoothed_, smoothed_valid_, d_, r_, k_);
+
+  const dsp::GridMask mask_q = grid_mask_to(smoothed_valid_);
+  dsp::ScalarField density_q{};
+  for (int i = 0; i < dsp::kGridCount; ++i) {
+    density_q.v[static_cast<std::size_t>(i)] =
+        static_cast<std::int32_t>(std::lround(density_[static_cast<std::size_t>(i)] * 65536.0));
+  }
+  const ForceFieldsRef forces =
+      force_map_ref(cal_, density_q, grid_vector_to_q16(d_), grid_vector_to_q16(r_),
+                    grid_vector_to_q16(k_), mask_q);
+  fz_ = forces.fz;
+  shear_x_ = forces.fx;
+  shear_y_ = forces.fy;
+  const ContactSetRef contact = contact_stage_.detect(fz_, grid_vector_to_q16(smoothed_), mask_q);
+
+  const int min_tracked = static_cast<int>(
+      std::ceil(config_.min_tracked_fraction * static_cast<double>(dsp::kGridCount)));
+  if (tracked < min_tracked) {
+    degraded = true;
+    motion_stage_.reset();
+    return true;
+  }
+  const double dt = (std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= 1.0) ? dt_s : 1.0 / 120.0;
+  out = motion_stage_.update(contact, shear_x_, shear_y_, dt);
+  return true;
+}
+
+DualPipelineRef::DualPipelineRef(const dsp::DualConfig& config,
+                                 const std::array<dsp::Calibration, 2>& cal)
+    : config_(config), cal_(cal) {
+  sensors_.emplace_back(config.pipeline, cal[0]);
+  sensors_.emplace_back(config.pipeline, cal[1]);
+}
+
+void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* right,
+                              std::int64_t t_ns, DualResultRef& out) {
+  out = DualResultRef{};
+  double dt = config_.nominal_frame_period_s;
+  if (have_last_t_ && t_ns > last_t_ns_) {
+    dt = static_cast<double>(t_ns - last_t_ns_) * 1e-9;
+    if (dt > config_.max_frame_gap_s) dt = config_.nominal_frame_period_s;
+  }
+  last_t_ns_ = t_ns;
+  have_last_t_ = true;
+
+  const dsp::FrameView* frames[2] = {left, right};
+  std::array<SensorMotionRef, 2> m{};
+  std::array<bool, 2> ok{false, false};
+  for (int i = 0; i < 2; ++i) {
+    if (frames[i] == nullptr) continue;
+    bool degraded = false;
+    if (sensors_[static_cast<std::size_t>(i)].process(*frames[i], dt, m[static_cast<std::size_t>(i)],
+                                                      degraded)) {
+      ok[static_cast<std::size_t>(i)] = !degraded;
+    }
+  }
+
+  const dsp::FusionConfig& fc = config_.fusion;
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  if (fc.method == dsp::FusionMethod::kJoint) {
+    // Every contact point and its proxy in G, one stacked shear-only least squares about the
+    // centroid of all points (dsp/fusion.cpp), λ as in solve3.
+    std::vector<PointSample> all;
+    Eigen::Matrix3d scale = Eigen::Matrix3d::Zero();
+    int nw = 0;
+    for (int i = 0; i < 2; ++i) {
+      const auto& s = m[static_cast<std::size_t>(i)];
+      if (!ok[static_cast<std::size_t>(i)] || !s.contact || !s.proxy_valid) continue;
+      const dsp::SensorExtrinsics& e = fc.extrinsics[static_cast<std::size_t>(i)];
+      const Eigen::Vector3d p = e.p_GS(config_.finger_separation_m);
+      for (const PointSample& ps : s.samples) {
+        PointSample g;
+        g.q = e.R_GS * ps.q + p;
+        g.v = e.R_GS * ps.v;
+        g.normal = e.R_GS * ps.normal;
+        all.push_back(g);
+      }
+      const auto& rs = cal_[static_cast<std::size_t>(i)].rotation_scale;
+      scale += e.R_GS * Eigen::Vector3d(rs[0], rs[1], rs[2]).asDiagonal() * e.R_GS.transpose();
+      ++nw;
+    }
+    if (!all.empty()) {
+      const std::vector<PointSample> about = shifted(all, centroid(all));
+      const StackedSystem sys = stack_shear_rows(about);
+      const double n = static_cast<double>(all.size());
+      const double lambda = fc.solve_lambda_rel * sys.A.squaredNorm() / 3.0 +
+                            n * fc.solve_lever_floor_m * fc.solve_lever_floor_m;
+      omega = (scale / nw) * solve_stacked(sys, lambda);
+      out.rotation_valid = true;
+    }
+    Eigen::Vector3d v_mean = Eigen::Vector3d::Zero();
+    Eigen::Vector3d c_mean = Eigen::Vector3d::Zero();
+    int nt = 0;
+    for (int i = 0; i < 2; ++i) {
+      const auto& s = m[static_cast<std::size_t>(i)];
+      if (!ok[static_cast<std::size_t>(i)] || !s.contact || !s.translation_valid) continue;
+      const dsp::SensorExtrinsics& e = fc.extrinsics[static_cast<std::size_t>(i)];
+      v_mean += e.R_GS * s.translation;
+      c_mean += e.R_GS * s.centroid + e.p_GS(config_.finger_separation_m);
+      ++nt;
+    }
+    if (nt > 0) {
+      t = v_mean / nt - omega.cross(c_mean / nt);
+      t.z() = 0.0;
+    }
+  } else {
+    // Paper Sec. V-C: ξ = ½(ξ₁ + S ξ₂), then R_GS of sensor 1.
+    int nw = 0, nt = 0;
+    for (int i = 0; i < 2; ++i) {
+      const auto& s = m[static_cast<std::size_t>(i)];
+      if (!ok[static_cast<std::size_t>(i)] || !s.contact) continue;
+      Eigen::Vector3d sw = Eigen::Vector3d::Ones(), st = Eigen::Vector3d::Ones();
+      if (i == 1) {
+        sw = Eigen::Vector3d(fc.sign[0], fc.sign[1], fc.sign[2]);
+        st = Eigen::Vector3d(fc.sign[3], fc.sign[4], fc.sign[5]);
+      }
+      if (s.proxy_valid) {
+        omega += sw.cwiseProduct(s.omega);
+        ++nw;
+      }
+      if (s.translation_valid) {
+        t += st.cwiseProduct(s.translation);
+        ++nt;
+      }
+    }
+    const Eigen::Matrix3d& R1 = fc.extrinsics[0].R_GS;
+    if (nw > 0) omega = R1 * (omega / nw);
+    if (nt > 0) t = R1 * (t / nt);
+    out.rotation_valid = nw > 0;
+  }
+  out.fused.head<3>() = omega;
+  out.fused.tail<3>() = t;
+
+  // Moving average as an explicit mean over the last L frames.
+  const auto L = static_cast<std::size_t>(cal_[0].moving_average_length);
+  window_.push_back(out.fused);
+  if (window_.size() > L) window_.erase(window_.begin());
+  dsp::Vector6d sum = dsp::Vector6d::Zero();
+  for (const auto& x : window_) sum += x;
+  out.twist = sum / static_cast<double>(window_.size());
+
+  pose_ = dsp::integrate_spatial(pose_, out.twist, dt);
+  out.pose = pose_;
+}
+
+}  // namespace tacse3::dsp_ref

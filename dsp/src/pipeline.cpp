@@ -1,0 +1,258 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 dsp: the per-sensor and dual-sensor TacSE3 pipelines that chain every stage per frame.
+#include "tacse3/dsp/pipeline.hpp"
+
+#include <cmath>
+
+#include "tacse3/dsp/luma.hpp"
+
+namespace tacse3::dsp {
+namespace {
+
+bool finite_in(double v, double lo, double hi) noexcept {
+  return std::isfinite(v) && v >= lo && v <= hi;
+}
+
+}  // namespace
+
+Status validate(const PipelineConfig& config) noexcept {
+  if (validate(config.flow) != Status::kOk) return Status::kBadArgument;
+  // The smoother, density and NHHD validate in their configure(); probe them on scratch objects
+  // would cost ~100 KB of stack, so their ranges are re-checked when SensorPipeline configures.
+  if (!finite_in(config.min_tracked_fraction, 1e-6, 1.0)) return Status::kBadArgument;
+  return Status::kOk;
+}
+
+SensorPipeline::SensorPipeline() noexcept { (void)configure(PipelineConfig{}, Calibration{}); }
+
+Status SensorPipeline::configure(const PipelineConfig& config, const Calibration& cal) noexcept {
+  if (validate(config) != Status::kOk) return Status::kBadArgument;
+  if (validate(cal) != Status::kOk) return Status::kBadCalibration;
+  // Stage configure() calls keep their previous state on error, so check them all on the live
+  // objects in an order where a failure leaves everything as it was: the stages that can reject
+  // a config are probed first with their current config restored on failure.
+  const SmoothingConfig old_smoothing = smoother_.config();
+  const DensityConfig old_density = density_.config();
+  const NhhdConfig old_nhhd = nhhd_.config();
+  if (smoother_.configure(config.smoothing) != Status::kOk) return Status::kBadArgument;
+  if (density_.configure(config.density) != Status::kOk) {
+    (void)smoother_.configure(old_smoothing);
+    return Status::kBadArgument;
+  }
+  if (nhhd_.configure(config.nhhd) != Status::kOk) {
+    (void)smoother_.configure(old_smoothing);
+    (void)density_.configure(old_density);
+    return Status::kBadArgument;
+  }
+  (void)old_nhhd;
+  (void)flow_.configure(config.flow);  // validated above
+  (void)forces_.configure(cal);        // validated above
+  (void)contact_.configure(cal);
+  (void)motion_.configure(cal);
+  config_ = config;
+  cal_ = cal;
+  min_tracked_points_ =
+      static_cast<int>(std::ceil(config.min_tracked_fraction * static_cast<double>(kGridCount)));
+  tare_pending_ = true;
+  nhhd_.reset();
+  contact_.reset();
+  motion_.reset();
+  return Status::kOk;
+}
+
+Status SensorPipeline::set_calibration(const Calibration& cal) noexcept {
+  if (validate(cal) != Status::kOk) return Status::kBadCalibration;
+  (void)forces_.configure(cal);
+  (void)contact_.configure(cal);
+  (void)motion_.configure(cal);
+  cal_ = cal;
+  return Status::kOk;
+}
+
+void SensorPipeline::tare() noexcept {
+  if (flow_.has_reference()) {
+    // The last processed frame is still in fields_.work: it becomes the reference now, so the
+    // very next frame already measures against it.
+    flow_.tare(fields_.work);
+    tare_pending_ = false;
+  } else {
+    tare_pending_ = true;
+  }
+  nhhd_.reset();
+  contact_.reset();
+  motion_.reset();
+}
+
+void SensorPipeline::restart_motion() noexcept { motion_.reset(); }
+
+void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& out) noexcept {
+  out = SensorResult{};
+  // Stage 1 (Sec. IV-B): luma and 2x2 downsample. A malformed frame is rejected before any state
+  // is touched; check_frame and the conversion share the same rules.
+  const Status input = check_frame(frame);
+  if (input != Status::kOk) {
+    out.status = input;
+    return;
+  }
+  (void)frame_to_work_image(frame, fields_.work);
+
+  // Stage 2: block flow against the adaptive reference, Eq. (dense_flow).
+  if (tare_pending_) {
+    flow_.tare(fields_.work);
+    tare_pending_ = false;
+    out.reference_taken = true;
+  }
+  flow_.track(fields_.work, fields_.flow, fields_.flow_valid);
+  out.tracked_points = flow_.valid_count();
+  out.keyframe_switches = flow_.keyframe_switches();
+
+  // Stage 3: separable Gaussian smoothing, then the Gaussian density 𝒢.
+  smoother_.apply(fields_.flow, fields_.flow_valid, fields_.smoothed, fields_.smoothed_valid);
+  density_.compute(fields_.smoothed, fields_.smoothed_valid, fields_.density);
+
+  // Stage 4: NHHD w = d + r + k, Eq. (nhhd), fixed work per frame, warm-started.
+  nhhd_.decompose(fields_.smoothed, fields_.smoothed_valid, fields_.d, fields_.r, fields_.k);
+
+  // Stage 5: calibrated linear maps to f^z and shear.
+  forces_.compute(fields_.density, fields_.d, fields_.r, fields_.k, fields_.smoothed_valid,
+                  fields_.fz, fields_.shear);
+
+  // Stage 6: contact mask Ω and 3D contact points q at the points' current positions.
+  contact_.detect(fields_.fz, fields_.smoothed, fields_.smoothed_valid, fields_.contact);
+
+  out.processed = true;
+  out.degraded = out.tracked_points < min_tracked_points_;
+  if (out.degraded) {
+    // Too little of the pad is trackable (dark, saturated, occluded or unrelated frame): its
+    // shear would be stale, so the motion state restarts instead of differentiating across it.
+    motion_.reset();
+    return;
+  }
+  const double dt = (std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= 1.0) ? dt_s : 1.0 / 120.0;
+  // Stages 7-8: centroid translation, velocity proxy, moments and the own-frame ω solve.
+  (void)motion_.update(fields_.contact, fields_.shear, dt, out.motion);
+}
+
+Status validate(const DualConfig& config) noexcept {
+  if (validate(config.pipeline) != Status::kOk) return Status::kBadArgument;
+  if (validate(config.fusion) != Status::kOk) return Status::kBadArgument;
+  if (!finite_in(config.finger_separation_m, 0.0, 0.5)) return Status::kBadArgument;
+  if (!finite_in(config.nominal_frame_period_s, 1e-4, 1.0)) return Status::kBadArgument;
+  if (!finite_in(config.max_frame_gap_s, 1e-4, 1.0)) return Status::kBadArgument;
+  return Status::kOk;
+}
+
+DualPipeline::DualPipeline() noexcept {
+  (void)configure(DualConfig{}, std::array<Calibration, 2>{Calibration{}, Calibration{}});
+}
+
+Status DualPipeline::configure(const DualConfig& config,
+                               const std::array<Calibration, 2>& cal) noexcept {
+  if (validate(config) != Status::kOk) return Status::kBadArgument;
+  for (const auto& c : cal) {
+    if (validate(c) != Status::kOk) return Status::kBadCalibration;
+  }
+  for (std::size_t i = 0; i < sensors_.size(); ++i) {
+    const Status s = sensors_[i].configure(config.pipeline, cal[i]);
+    if (s != Status::kOk) return s;
+  }
+  (void)average_.set_length(cal[0].moving_average_length);
+  config_ = config;
+  cal_ = cal;
+  integrator_.reset();
+  have_last_t_ = false;
+  return Status::kOk;
+}
+
+Status DualPipeline::set_calibration(const std::array<Calibration, 2>& cal) noexcept {
+  for (const auto& c : cal) {
+    if (validate(c) != Status::kOk) return Status::kBadCalibration;
+  }
+  for (std::size_t i = 0; i < sensors_.size(); ++i) (void)sensors_[i].set_calibration(cal[i]);
+  if (cal[0].moving_average_length != average_.length()) {
+    (void)average_.set_length(cal[0].moving_average_length);
+  }
+  cal_ = cal;
+  return Status::kOk;
+}
+
+void DualPipeline::process(const FrameView* left, const FrameView* right, std::int64_t t_ns,
+                           DualResult& out) noexcept {
+  out.t_ns = t_ns;
+  out.present = {left != nullptr, right != nullptr};
+
+  // Step: measured from the sample times; nominal for the first pair or a clock that did not
+  // advance. A gap longer than max_frame_gap_s restarts the per-sensor motion differencing.
+  double dt = config_.nominal_frame_period_s;
+  bool gap = false;
+  if (have_last_t_ && t_ns > last_t_ns_) {
+    dt = static_cast<double>(t_ns - last_t_ns_) * 1e-9;
+    if (dt > config_.max_frame_gap_s) {
+      gap = true;
+      dt = config_.nominal_frame_period_s;
+    }
+  }
+  last_t_ns_ = t_ns;
+  have_last_t_ = true;
+  out.dt_s = dt;
+
+  const FrameView* frames[2] = {left, right};
+  const SensorMotion* motions[2] = {nullptr, nullptr};
+  for (std::size_t i = 0; i < 2; ++i) {
+    SensorResult& r = out.sensors[i];
+    if (frames[i] == nullptr) {
+      r = SensorResult{};
+      // A sensor that misses a cycle must not difference its next frame against a stale one.
+      sensors_[i].restart_motion();
+      continue;
+    }
+    if (gap) sensors_[i].restart_motion();
+    sensors_[i].process(*frames[i], dt, r);
+    if (r.processed && !r.degraded) motions[i] = &r.motion;
+  }
+
+  // Fusion (Sec. V-C) in G; an absent sensor gives the flagged single-sensor mode.
+  (void)fuse(motions[0], motions[1], config_.fusion, config_.finger_separation_m, out.fused);
+  out.valid = out.fused.valid;
+  out.single_sensor = out.fused.single_sensor;
+
+  // Moving average (Sec. IV-D). A frame without a valid estimate contributes a zero twist: with
+  // no evidence of motion the object is held still rather than extrapolated.
+  out.twist = average_.push(out.fused.xi);
+
+  // SE(3) integration, T ← T·exp(ξ̂_b Δt) with ξ_b = Ad_{T⁻¹} ξ̄_G (se3.hpp).
+  (void)integrator_.step_spatial(out.twist, dt);
+  out.pose = integrator_.pose();
+}
+
+void DualPipeline::tare() noexcept {
+  for (auto& s : sensors_) s.tare();
+  average_.reset();
+}
+
+void DualPipeline::reset_pose() noexcept { integrator_.reset(); }
+
+Status DualPipeline::set_finger_separation(double separation_m) noexcept {
+  if (!finite_in(separation_m, 0.0, 0.5)) return Status::kBadArgument;
+  config_.finger_separation_m = separation_m;
+  return Status::kOk;
+}
+
+Status DualPipeline::set_fusion_method(FusionMethod method) noexcept {
+  if (method != FusionMethod::kPaper && method != FusionMethod::kJoint) {
+    return Status::kBadArgument;
+  }
+  config_.fusion.method = method;
+  return Status::kOk;
+}
+
+Status DualPipeline::set_velocity_proxy(VelocityProxy mode) noexcept {
+  if (mode != VelocityProxy::kVelocity && mode != VelocityProxy::kDisplacement) {
+    return Status::kBadArgument;
+  }
+  std::array<Calibration, 2> cal = cal_;
+  for (auto& c : cal) c.velocity_proxy = mode;
+  return set_calibration(cal);
+}
+
+}  // namespace tacse3::dsp
