@@ -1,0 +1,243 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tests: end-to-end dual-sensor pipeline on synthetic grasps, against truth and reference.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "support/scenes.hpp"
+#include "tacse3/dsp/pipeline.hpp"
+#include "tacse3/dsp_ref/pipeline_ref.hpp"
+
+namespace tacse3::dsp {
+namespace {
+
+using test::GraspScene;
+
+constexpr double kDeg = M_PI / 180.0;
+
+struct Rendered {
+  GraspScene scene;
+  std::vector<std::vector<std::uint8_t>> frames[2];
+};
+
+Rendered render(const GraspScene& s) {
+  Rendered r{s, {}};
+  const test::DotTexture left(s.seed), right(s.seed + 1000);
+  for (int pad = 0; pad < 2; ++pad) {
+    for (int f = 0; f < test::scene_frames(s); ++f) {
+      r.frames[pad].push_back(test::render_scene_frame(s, pad == 0 ? left : right, pad, f));
+    }
+  }
+  return r;
+}
+
+DualConfig dual_config(const GraspScene& s, FusionMethod method) {
+  DualConfig c;
+  c.finger_separation_m = s.separation_m;
+  c.fusion.method = method;
+  return c;
+}
+
+std::array<Calibration, 2> calibration(VelocityProxy mode) {
+  Calibration cal;
+  cal.velocity_proxy = mode;
+  cal.moving_average_length = 1;  // the averaging has its own tests; keep the pose exact here
+  return {cal, cal};
+}
+
+struct RunResult {
+  std::vector<Vector6d> twist;
+  Pose pose;
+  int valid_frames = 0;
+};
+
+RunResult run_fixed(const Rendered& r, const DualConfig& cfg, const std::array<Calibration, 2>& cal) {
+  auto p = std::make_unique<DualPipeline>();
+  EXPECT_EQ(p->configure(cfg, cal), Status::kOk);
+  RunResult out;
+  const std::int64_t period_ns = static_cast<std::int64_t>(1e9 / r.scene.fps);
+  for (std::size_t f = 0; f < r.frames[0].size(); ++f) {
+    const FrameView l = test::frame_view(r.frames[0][f], PixelFormat::kRgb888);
+    const FrameView rt = test::frame_view(r.frames[1][f], PixelFormat::kRgb888);
+    DualResult res;
+    p->process(&l, &rt, static_cast<std::int64_t>(f) * period_ns, res);
+    out.twist.push_back(res.twist);
+    out.valid_frames += res.valid ? 1 : 0;
+    out.pose = res.pose;
+  }
+  return out;
+}
+
+RunResult run_reference(const Rendered& r, const DualConfig& cfg,
+                        const std::array<Calibration, 2>& cal) {
+  dsp_ref::DualPipelineRef p(cfg, cal);
+  RunResult out;
+  const std::int64_t period_ns = static_cast<std::int64_t>(1e9 / r.scene.fps);
+  for (std::size_t f = 0; f < r.frames[0].size(); ++f) {
+    const FrameView l = test::frame_view(r.frames[0][f], PixelFormat::kRgb888);
+    const FrameView rt = test::frame_view(r.frames[1][f], PixelFormat::kRgb888);
+    dsp_ref::DualResultRef res;
+    p.process(&l, &rt, static_cast<std::int64_t>(f) * period_ns, res);
+    out.twist.push_back(res.twist);
+    out.pose = res.pose;
+  }
+  return out;
+}
+
+// Rotation vector of a pose (rad).
+Eigen::Vector3d rotation_vector(const Pose& T) { return so3_log(T.q); }
+
+// SNR (dB) of `test` against `ref` over the angular part of a twist sequence.
+double omega_snr_db(const std::vector<Vector6d>& ref, const std::vector<Vector6d>& test) {
+  double s = 0.0, n = 0.0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    s += ref[i].head<3>().squaredNorm();
+    n += (ref[i].head<3>() - test[i].head<3>()).squaredNorm();
+  }
+  return 10.0 * std::log10(s / std::max(n, 1e-30));
+}
+
+// Short grasps (6 grasp + 16 motion + 4 hold frames) keep the suite fast under qemu and ASan.
+GraspScene short_scene() {
+  GraspScene s;
+  s.grasp_frames = 6;
+  s.motion_frames = 16;
+  s.hold_frames = 4;
+  return s;
+}
+
+const Rendered& rotation_about_z() {
+  static const Rendered r = [] {
+    GraspScene s = short_scene();
+    s.motion << 0, 0, 3.0 * kDeg, 0, 0, 0;
+    return render(s);
+  }();
+  return r;
+}
+
+const Rendered& rotation_about_x() {
+  static const Rendered r = [] {
+    GraspScene s = short_scene();
+    s.motion << 1.5 * kDeg, 0, 0, 0, 0, 0;
+    return render(s);
+  }();
+  return r;
+}
+
+const Rendered& translation_along_y() {
+  static const Rendered r = [] {
+    GraspScene s = short_scene();
+    s.motion << 0, 0, 0, 0, 0.4e-3, 0;
+    return render(s);
+  }();
+  return r;
+}
+
+double rms_omega_difference(const std::vector<Vector6d>& a, const std::vector<Vector6d>& b) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) sum += (a[i].head<3>() - b[i].head<3>()).squaredNorm();
+  return std::sqrt(sum / static_cast<double>(a.size()));
+}
+
+// Fixed point vs the double reference, end to end (twist every frame, final pose).
+// Measured on x86-64 (worst case over the four cases): final angle 0.09° apart on a 30° estimate
+// (0.3 %), ω SNR ≥ 39 dB wherever the estimate is more than half a degree, RMS ω difference
+// 0.014 rad/s on the drift-only translation case, positions 27 µm apart in velocity mode. The
+// position and drift differences come from single grid cells on the τ threshold of Ω that one
+// implementation keeps and the other drops (the mask is a hard decision), which moves the
+// contact centroid by a fraction of a cell. The bounds leave about 2-3x margin for aarch64,
+// where the reference's doubles may contract into FMAs.
+struct AgreementCase {
+  const char* name;
+  const Rendered& (*scene)();
+  FusionMethod method;
+  VelocityProxy mode;
+};
+
+class FixedVsReference : public ::testing::TestWithParam<AgreementCase> {};
+
+TEST_P(FixedVsReference, TwistAndFinalPoseAgree) {
+  const AgreementCase& c = GetParam();
+  const Rendered& r = c.scene();
+  const auto cfg = dual_config(r.scene, c.method);
+  const auto cal = calibration(c.mode);
+  const RunResult fx = run_fixed(r, cfg, cal);
+  const RunResult ref = run_reference(r, cfg, cal);
+  const Eigen::Vector3d a = rotation_vector(fx.pose), b = rotation_vector(ref.pose);
+  std::printf("%s: fixed (%.4f %.4f %.4f) deg, reference (%.4f %.4f %.4f) deg, omega SNR %.1f dB, "
+              "RMS omega diff %.2e rad/s, position diff %.2e m\n",
+              c.name, a.x() / kDeg, a.y() / kDeg, a.z() / kDeg, b.x() / kDeg, b.y() / kDeg,
+              b.z() / kDeg, omega_snr_db(ref.twist, fx.twist),
+              rms_omega_difference(ref.twist, fx.twist), (fx.pose.p - ref.pose.p).norm());
+  EXPECT_LT((a - b).norm() / kDeg, 0.1 + 0.01 * b.norm() / kDeg);
+  EXPECT_LT((fx.pose.p - ref.pose.p).norm(), 100e-6);
+  if (b.norm() / kDeg > 0.5) {
+    EXPECT_GT(omega_snr_db(ref.twist, fx.twist), 30.0);
+  } else {
+    EXPECT_LT(rms_omega_difference(ref.twist, fx.twist), 0.04);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenes, FixedVsReference,
+    ::testing::Values(
+        AgreementCase{"rz3_joint_displacement", rotation_about_z, FusionMethod::kJoint,
+                      VelocityProxy::kDisplacement},
+        AgreementCase{"rz3_paper_velocity", rotation_about_z, FusionMethod::kPaper,
+                      VelocityProxy::kVelocity},
+        AgreementCase{"rx1.5_joint_velocity", rotation_about_x, FusionMethod::kJoint,
+                      VelocityProxy::kVelocity},
+        AgreementCase{"ty0.4_paper_displacement", translation_along_y, FusionMethod::kPaper,
+                      VelocityProxy::kDisplacement}),
+    [](const ::testing::TestParamInfo<AgreementCase>& i) {
+      std::string n = i.param.name;
+      for (char& ch : n) {
+        if (ch == '.') ch = '_';
+      }
+      return n;
+    });
+
+// Against the scene's truth, with the kinematic (displacement) proxy and the joint fusion, which
+// need no calibration while the contact sticks. The estimate reads the gel through 16x16 px
+// flow windows and a σ = 8 px smoothing, and Ω reaches a little beyond the sticking patch where
+// the gel has already relaxed, so the magnitudes come out 10-30 % low (measured: rz 92 %,
+// rx 74 %, ty 77 %); the per-axis calibration scales absorb that. What must hold exactly is
+// the direction, the sign and the separation of the axes.
+TEST(PipelineTruth, RotationAboutNormalAxis) {
+  const Rendered& r = rotation_about_z();
+  const RunResult fx = run_fixed(r, dual_config(r.scene, FusionMethod::kJoint),
+                                 calibration(VelocityProxy::kDisplacement));
+  const Eigen::Vector3d rv = rotation_vector(fx.pose) / kDeg;
+  EXPECT_GT(rv.z(), 3.0 * 0.8);
+  EXPECT_LT(rv.z(), 3.0 * 1.1);
+  EXPECT_LT(std::hypot(rv.x(), rv.y()), 0.05);
+  EXPECT_LT(fx.pose.p.norm(), 20e-6);
+  EXPECT_GE(fx.valid_frames, r.scene.motion_frames);
+}
+
+TEST(PipelineTruth, RotationAboutFingerAxisUsesThePadLeverArm) {
+  const Rendered& r = rotation_about_x();
+  const RunResult fx = run_fixed(r, dual_config(r.scene, FusionMethod::kJoint),
+                                 calibration(VelocityProxy::kDisplacement));
+  const Eigen::Vector3d rv = rotation_vector(fx.pose) / kDeg;
+  EXPECT_GT(rv.x(), 1.5 * 0.6);
+  EXPECT_LT(rv.x(), 1.5 * 1.1);
+  EXPECT_LT(std::hypot(rv.y(), rv.z()), 0.05);
+  EXPECT_LT(fx.pose.p.norm(), 20e-6);
+}
+
+TEST(PipelineTruth, TranslationDoesNotLeakIntoRotation) {
+  const Rendered& r = translation_along_y();
+  const RunResult fx = run_fixed(r, dual_config(r.scene, FusionMethod::kJoint),
+                                 calibration(VelocityProxy::kDisplacement));
+  const Eigen::Vector3d rv = rotation_vector(fx.pose) / kDeg;
+  EXPECT_LT(rv.norm(), 0.05) << "rotation drift under pure translation";
+  EXPECT_GT(fx.pose.p.y(), 0.4e-3 * 0.6);
+  EXPECT_LT(fx.pose.p.y(), 0.4e-3 * 1.1);
+  EXPECT_LT(std::hypot(fx.pose.p.x(), fx.pose.p.z()), 20e-6);
+}
+
+}  // namespace
+}  // namespace tacse3::dsp
