@@ -167,7 +167,17 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   out.mask_change = uni > 0 ? 1.0 - static_cast<double>(common) / static_cast<double>(uni) : 1.0;
   if (m.n > 0 && prev_count_ > 0) {
     Eigen::Vector3d disp = Eigen::Vector3d::Zero();
-    if (out.mask_change <= max_mask_change_) {
+    if (displacement && common > 0) {
+      // While the contact sticks the gel material moves with the object, so the mean displacement
+      // of the material points in both masks is the contact displacement itself. The mask
+      // centroid is not used here: a tangential load stretches the gel behind the patch and
+      // compresses it ahead, which moves Ω (read from 𝒢) backwards although nothing slid.
+      const double nc = static_cast<double>(common);
+      disp.x() = static_cast<double>(common_dx) / nc * kNm;
+      disp.y() = static_cast<double>(common_dy) / nc * kNm;
+      out.translation_source = TranslationSource::kCommonPoints;
+      out.translation_valid = true;
+    } else if (out.mask_change <= max_mask_change_) {
       const double nt = static_cast<double>(m.n), np = static_cast<double>(prev_count_);
       disp.x() = (static_cast<double>(m.sx) / nt - static_cast<double>(prev_sx_) / np) * kNm;
       disp.y() = (static_cast<double>(m.sy) / nt - static_cast<double>(prev_sy_) / np) * kNm;

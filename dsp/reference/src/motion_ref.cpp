@@ -120,7 +120,12 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     const int uni = out.points + prev_count - common;
     const double change = 1.0 - static_cast<double>(common) / uni;
     Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    if (change <= cal_.max_mask_change) {
+    const bool sticking = cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
+    if (sticking && common > 0) {
+      d = sum_common / common;
+      out.translation_source = 2;
+      out.translation_valid = true;
+    } else if (change <= cal_.max_mask_change) {
       d = sum_now / out.points - sum_prev / prev_count;
       out.translation_source = 1;
       out.translation_valid = true;

@@ -86,6 +86,9 @@ struct SensorMotion {
 //  - Translation (paper Sec. IV-D "contact-centroid planar translation"): c_t = mean of the
 //    current positions over Ω_t; t = (c_t − c_{t−1}) / Δt, t_z = 0. Spike rules:
 //      * onset (Ω_{t−1} empty) or loss (Ω_t empty): t = 0, translation_valid = false;
+//      * kDisplacement proxy (the contact sticks): t is the mean displacement of the material
+//        points present in both masks — exact kinematics, and blind to Ω creeping backwards
+//        when a tangential load stretches the gel behind the patch (𝒢 reads that as expansion);
 //      * if 1 − |Ω_t ∩ Ω_{t−1}| / |Ω_t ∪ Ω_{t−1}| > max_mask_change, cells entering/leaving
 //        would move the centroid without any object motion, so t is the mean displacement of
 //        the material points present in both masks (exact while the contact sticks);
