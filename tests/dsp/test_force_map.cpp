@@ -164,19 +164,19 @@ TEST(ForceMap, SaturatesAtMaxPosAndMaxNeg) {
 }
 
 TEST(ForceMap, InvalidPointsAreZeroAndUndeformedIsZero) {
-  ForceMap fm;  // defaults: f^z = −𝒢, shear = r + k
+  ForceMap fm;  // defaults: f^z = −𝒢, shear = d + r + k
   auto in = std::make_unique<Inputs>();
   in->valid.fill(1);
   // Undeformed (𝒢 = 0) under a uniform shift: all of it is the harmonic part k.
   in->k.x.fill(to_q32<16>(0.75));
   in->k.y.fill(to_q32<16>(-0.25));
-  in->d.x.fill(to_q32<16>(3.0));  // d is ignored by default (s_d = 0)
+  in->d.x.fill(to_q32<16>(3.0));  // d enters with the default s_d = 1
   in->valid(3, 4) = 0;
   ScalarField fz;
   VectorField shear;
   fm.compute(in->density, in->d, in->r, in->k, in->valid, fz, shear);
   EXPECT_EQ(fz(0, 0), 0);
-  EXPECT_EQ(shear.x(0, 0), to_q32<16>(0.75));
+  EXPECT_EQ(shear.x(0, 0), to_q32<16>(3.75));
   EXPECT_EQ(shear.y(20, 20), to_q32<16>(-0.25));
   EXPECT_EQ(shear.x(3, 4), 0);
   EXPECT_EQ(shear.y(3, 4), 0);

@@ -37,8 +37,12 @@ struct Calibration {
   double normal_gain_divergence = 0.0;  // per unit of div d (working px / working px). [0, 1e4]
 
   // --- shear (f^x, f^y) = s_d · d + s_r · r + s_k · k  (Eq. nhhd parts, working px)
-  // Default: the curl-free part d is the radial bulge of normal indentation, not shear.
-  double shear_gain_d = 0.0;  // [0, 1e4]
+  // Default 1: for a compact contact the natural HHD splits a locally uniform shear about evenly
+  // between d and r (measured in tests/dsp/test_pipeline.cpp: dropping d halves the in-plane
+  // kinematics of a rotation about the finger axis), while the radial bulge of the indentation
+  // that d also carries is symmetric about the patch and drops out of the rotation moments.
+  // The calibration tool fits all three gains.
+  double shear_gain_d = 1.0;  // [0, 1e4]
   double shear_gain_r = 1.0;  // [0, 1e4]
   double shear_gain_k = 1.0;  // [0, 1e4]
 
