@@ -18,12 +18,23 @@ PACKAGES=(
   # libraries
   libeigen3-dev googletest libgtest-dev libbenchmark-dev
   libtomlplusplus-dev libcli11-dev libspng-dev libpng-dev nlohmann-json3-dev
+  # hardware backends: MJPEG decode, GPIO, libcamera
+  libturbojpeg0-dev libgpiod-dev libcamera-dev
+  # fuzzing (libFuzzer and sanitizer runtimes for clang)
+  libclang-rt-14-dev
   # protocol cross-checks: python-can example and the independent DBC decoder (npm)
-  python3 python3-can nodejs npm
+  python3 python3-can
 )
 
 $SUDO apt-get update -o Acquire::Retries=5
 $SUDO apt-get install "${APT_OPTS[@]}" "${PACKAGES[@]}"
+# Debian's npm conflicts with a NodeSource nodejs: install it only when no npm is present.
+command -v npm >/dev/null || $SUDO apt-get install "${APT_OPTS[@]}" nodejs npm
+
+# Target libraries (libgpiod, turbojpeg, libcamera) for the aarch64 and armhf cross builds,
+# unpacked into build/sysroot/<arch> without touching the host's packages.
+scripts/make-sysroot.sh aarch64
+scripts/make-sysroot.sh armhf
 
 # The independent DBC decoder used by the protocol tests (pinned by package-lock.json).
 for dir in tests/protocol/dbc; do
