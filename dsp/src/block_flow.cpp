@@ -10,12 +10,13 @@
 // tensor, its inverse and all template statistics are fixed per keyframe; an iteration only
 // samples the current image and accumulates the mismatch vector.
 //
-// Fixed-point formats (docs/dsp-front.md has the full table with ranges and rounding):
+// Fixed-point formats (docs/dsp.md has the full table with ranges and rounding):
 //   I, T       U8.2 pyramid samples, 0..1020 (luma * 4)
 //   g          gx, gy = T(x+1) - T(x-1): int16, |g| <= 1020 (2 * U8.2 per level px)
-//   v          bilinear sample of I_t with Q6 weights, >> 1: U8.7 (luma * 128), 0..32640
-//   r          v - 32 T: int16, |r| <= 32640 (U8.7)
-//   S_gr, S_tr sum g r, sum T r over 64 px: int32, |.| <= 64 * 1020 * 32640 = 2130739200 < 2^31
+//   h          horizontal bilinear pass (32 - fx) a + fx b: int16 U8.7, 0..32640, exact
+//   v          vertical pass h0 + (h1 - h0) fy / 32 (16-bit high multiply, floor): U8.7
+//   r          v - 32 T: int16, |r| <= 32642 (U8.7; v may be 2 LSB below 0 after the floor)
+//   S_gr, S_tr sum g r, sum T r over 64 px: int32, |.| <= 64 * 1020 * 32642 = 2130869760 < 2^31
 //   S_r        sum r: int32, |S_r| <= 2088960
 //   b64        64 S_gr - (sum g) S_r = 64 * sum (g - mean g) r: int64, |b64| < 2^38
 //   bT         64 S_tr - (sum T) S_r - compensation: int64, |bT| < 2^39
@@ -44,7 +45,7 @@ constexpr std::int64_t kN = kFlowWindowPixels;
 constexpr std::int32_t kWindowCentreQ16 = (kFlowWindow - 1) * kHalf;
 // Sub-pixel sampling resolution: positions are rounded to 1/32 px (Q5) before sampling; the
 // Gauss-Newton step computed there is added to the rounded position, so the rounding only
-// enters at second order (see docs/dsp-front.md).
+// enters at second order (see docs/dsp.md).
 constexpr int kPosFrac = 5;
 constexpr int kQ16ToPos = 16 - kPosFrac;
 // Window origins are kept one pixel inside the image: every template pixel then has both
@@ -91,27 +92,54 @@ struct WindowSums {
 };
 
 // The hot loop. (1) Bilinear sample of the current image at a constant sub-pixel offset (the
-// displacement is constant over the window, so the four weights are too) and the residual
-// against the template, row by row over contiguous samples; (2) the four mismatch sums as flat
-// 64-long dot products over the packed template. Arithmetic is 16-bit with 32-bit sums, which
-// g++ -O2 turns into SIMD (pmullw/pmaddwd on x86, mul/smlal on NEON).
-//   cur: top-left sample of the 9x9 source block. Weights Q6: w00 + w01 + w10 + w11 = 64, so
-//   the sample sum is <= 64 * 1020 = 65280 (uint16); v = sum >> 1 is U8.7 (floor: a constant
-//   -1/2 LSB bias, removed by the zero-mean model). `res` receives the 64 residuals.
+// displacement is constant over the window, so the weights are too), separably: a horizontal
+// pass over the 9 source rows, h = (32 - fx) a + fx b (exact, <= 32 * 1020 = 32640, U8.7), then
+// a vertical pass v = h0 + 2 * ((h1 - h0) * (fy << 10) >> 16) = h0 + (h1 - h0) fy / 32, whose
+// product is a 16x16 -> high-16 multiply (pmulhw / sqdmulh class), floor-rounded (<= 2 LSB of
+// U8.7, i.e. 1/64 luma); (2) the residual against the template; (3) the four mismatch sums as
+// flat 64-long dot products over the packed template. Arithmetic is 16-bit with 32-bit sums,
+// which g++ -O2 vectorises (pmullw/pmulhw/pmaddwd on x86-64 SSE2, NEON on aarch64).
+//   cur: top-left sample of the 9x9 source block; fx, fy: Q5 fractions. `res` receives the 64
+//   residuals r = v - 32 T (|r| <= 32642, int16).
+// fy / 32 in Q15 (fy << 10) from a table: computed inline, g++ would fold the shift into the
+// product and lose the 16-bit high-multiply form of the vertical pass.
+constexpr std::array<std::int16_t, 32> make_fraction_q15() noexcept {
+  std::array<std::int16_t, 32> a{};
+  for (int f = 0; f < 32; ++f) a[static_cast<std::size_t>(f)] = static_cast<std::int16_t>(f << 10);
+  return a;
+}
+constexpr auto kFractionQ15 = make_fraction_q15();
+
+// Vertical half of the bilinear sample and the residual: v = h0 + 2 * ((h1 - h0) * wy >> 16)
+// with wy = fy << 10 (fy / 32 in Q15), r = v - 32 T. A separate function with restrict
+// pointers so that g++ maps the product to the 16-bit high multiply.
+inline void vertical_residual(const std::int16_t* __restrict h, const std::int16_t* __restrict t,
+                              std::int16_t wy, std::int16_t* __restrict res) noexcept {
+  alignas(16) std::array<std::int16_t, kFlowWindowPixels> hi{};
+  for (int k = 0; k < kFlowWindowPixels; ++k) {  // kept alone: the high-multiply pattern
+    const auto d = static_cast<std::int16_t>(h[k + kFlowWindow] - h[k]);
+    hi[static_cast<std::size_t>(k)] = static_cast<std::int16_t>((std::int32_t{d} * wy) >> 16);
+  }
+  for (int k = 0; k < kFlowWindowPixels; ++k) {
+    res[k] = static_cast<std::int16_t>(h[k] + 2 * hi[static_cast<std::size_t>(k)] - (t[k] << 5));
+  }
+}
+
 inline WindowSums sample_window(const std::uint16_t* __restrict cur, std::size_t stride,
-                                const FlowWindowTemplate& tpl, int w00, int w01, int w10, int w11,
+                                const FlowWindowTemplate& tpl, int fx, int fy,
                                 std::int16_t* __restrict res) noexcept {
-  const std::int16_t* __restrict t = tpl.t.data();
-  for (int row = 0; row < kFlowWindow; ++row) {
-    const std::uint16_t* c0 = cur + static_cast<std::size_t>(row) * stride;
-    const std::uint16_t* c1 = c0 + stride;
-    const int o = row * kFlowWindow;
+  alignas(16) std::array<std::int16_t, (kFlowWindow + 1) * kFlowWindow> h{};
+  const int wa = 32 - fx;
+  const int wb = fx;
+  for (int row = 0; row <= kFlowWindow; ++row) {
+    const std::uint16_t* c = cur + static_cast<std::size_t>(row) * stride;
+    std::int16_t* __restrict o = h.data() + row * kFlowWindow;
     for (int j = 0; j < kFlowWindow; ++j) {
-      const auto v =
-          static_cast<std::uint16_t>(w00 * c0[j] + w01 * c0[j + 1] + w10 * c1[j] + w11 * c1[j + 1]);
-      res[o + j] = static_cast<std::int16_t>((v >> 1) - (t[o + j] << 5));
+      o[j] = static_cast<std::int16_t>(wa * c[j] + wb * c[j + 1]);
     }
   }
+  const std::int16_t* __restrict t = tpl.t.data();
+  vertical_residual(h.data(), t, kFractionQ15[static_cast<std::size_t>(fy)], res);
   const std::int16_t* __restrict gx = tpl.gx.data();
   const std::int16_t* __restrict gy = tpl.gy.data();
   std::int32_t sx = 0;
@@ -639,15 +667,9 @@ BlockFlow::WindowResult BlockFlow::track_window(int level, int index, std::int32
     if (sx < 0 || sy < 0 || sx > max_x || sy > max_y) return {ux, uy, false, true};
     const int fx = sx & ((1 << kPosFrac) - 1);
     const int fy = sy & ((1 << kPosFrac) - 1);
-    // Q6 bilinear weights from Q5 fractions; the first moments (2 fx, 2 fy) are exact, only the
-    // cross term fx*fy is rounded (error <= 1/128 of a weight).
-    const int w11 = (fx * fy + 8) >> 4;
-    const int w01 = 2 * fx - w11;
-    const int w10 = 2 * fy - w11;
-    const int w00 = 64 - 2 * fx - 2 * fy + w11;
     const std::uint16_t* src = cur + static_cast<std::size_t>(sy >> kPosFrac) * stride +
                                static_cast<std::size_t>(sx >> kPosFrac);
-    sums = sample_window(src, stride, tpl, w00, w01, w10, w11, res.data());
+    sums = sample_window(src, stride, tpl, fx, fy, res.data());
     // Bilinear interpolation at fraction f of a signal G returns G + f (1 - f) / 2 * G'' (to
     // second order): the sampled window is a slightly smoothed copy of the template. That
     // smoothing biases the match by up to ~0.04 px on 8x8 windows, independent of texture

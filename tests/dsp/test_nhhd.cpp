@@ -264,7 +264,7 @@ TEST(Nhhd, AgreesWithFreeSpaceGreensFunctionDecomposition) {
 TEST(Nhhd, FixedPointMatchesDoubleReferenceOfTheSameScheme) {
   // Same config, same sequence of calls (warm start included): the only difference is integer
   // rounding (Q12 potentials, round-half-up in every sweep) and the Q16 quantisation of the
-  // input. Thresholds from the error budget in docs/dsp-mid.md: each sweep adds <= 0.5 Q12 LSB per
+  // input. Thresholds from the error budget in docs/dsp.md: each sweep adds <= 0.5 Q12 LSB per
   // point, the multigrid cycle is contractive, and d = 8 (phi[+1] - phi[-1]) maps 1 Q12 LSB of
   // potential error to 8-16 Q16 LSB. Measured ~75-80 dB and <= ~60 LSB.
   const NhhdConfig config;  // defaults

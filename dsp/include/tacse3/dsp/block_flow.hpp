@@ -79,7 +79,7 @@ struct FlowWindowTemplate {
 
 // Per-window model, precomputed when a keyframe is taken (inverse-compositional LK: the
 // template, its gradients and the inverse structure tensor stay fixed until the next keyframe).
-// Formats are listed at the top of block_flow.cpp and in docs/dsp-front.md.
+// Formats are listed at the top of block_flow.cpp and in docs/dsp.md.
 struct FlowWindowModel {
   // Block-floating-point inverse of the zero-mean, gain-eliminated structure tensor H64:
   // H64^-1 = [inv_a inv_b; inv_b inv_c] * 2^-(shift + 12). Mantissas |.| < 2^22.

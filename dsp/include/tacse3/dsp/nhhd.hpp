@@ -34,7 +34,7 @@ namespace tacse3::dsp {
 //     is enough: measured error against the Green's-function reference is 0.1-0.3 % (RMS,
 //     relative to |w|) for sources inside the grid and 1.5 % for a rotation/expansion filling the
 //     whole grid; a zero ring gives ~10 % here and would need > 16 cells of padding for 2 %
-//     (docs/dsp-mid.md).
+//     (docs/dsp.md).
 //
 // Solver (fixed cost per call): each Poisson problem is solved by `cycles` V-cycles on the padded
 // 47 x 39 grid (coarse levels 23 x 19, 11 x 9, 5 x 4), warm-started from the previous call's
