@@ -55,7 +55,7 @@ struct WindowRef {
 // position, exact inverse, exact divisions, unrounded pyramid. The same config, windows,
 // iteration and validity rules, on-demand coarse-to-fine, output corrections, keyframe policy,
 // neighbour fit and re-anchoring. The only intended differences are the fixed-point roundings
-// (1/32 px sampling, Q6 weights, Q16 results), and the stopping rule (|step| < 1/64 px instead
+// (1/32 px sampling, U8.7 samples, Q16 results), and the stopping rule (|step| < 1/64 px instead
 // of a repeated rounded position).
 class BlockFlowRef {
  public:
