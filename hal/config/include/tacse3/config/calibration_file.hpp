@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 config: the versioned TOML calibration file (docs/calibration.md): read, validate, write.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "tacse3/dsp/calibration.hpp"
+#include "tacse3/dsp/fusion.hpp"
+
+namespace tacse3::config {
+
+inline constexpr const char* kCalibrationFormat = "tacse3-calibration";
+inline constexpr int kCalibrationVersion = 1;
+
+// Success, or a message that names the file and the key at fault. Nothing in this library
+// throws (the daemon reloads the file on SIGHUP and must keep running on a bad file).
+class Status {
+ public:
+  Status() = default;
+  static Status error(std::string message) {
+    Status s;
+    s.message_ = message.empty() ? std::string("unknown error") : std::move(message);
+    return s;
+  }
+  bool ok() const noexcept { return message_.empty(); }
+  explicit operator bool() const noexcept { return ok(); }
+  const std::string& message() const noexcept { return message_; }
+
+ private:
+  std::string message_;
+};
+
+// Sensor slots of the file, in the order of dsp::DualPipeline (left = sensor 1).
+inline constexpr std::size_t kLeft = 0;
+inline constexpr std::size_t kRight = 1;
+
+// Per-axis scales used by the paper's fusion (ξ = ½(ξ₁ + S ξ₂)) instead of the sensor tables'
+// scales: with that fusion ω_x, ω_y come out lever-scaled (≈ W / 2z̄ too large), so they need
+// their own per-axis scales, while the joint fusion is in rad/s and keeps scales near 1.
+struct PaperScales {
+  std::array<double, 3> rotation_scale{1.0, 1.0, 1.0};
+  std::array<double, 3> translation_scale{1.0, 1.0, 1.0};
+};
+
+// Free-form provenance ([meta] table); informational only, never used by the pipeline.
+struct CalibrationMeta {
+  std::string generator;
+  std::string created;
+  std::string note;
+  std::vector<std::string> recordings;
+};
+
+// Everything a calibration file holds.
+struct CalibrationSet {
+  // Complete per-sensor calibration (left, right) as used with the joint fusion.
+  std::array<dsp::Calibration, 2> sensor{};
+  // Scales that replace sensor[i].rotation_scale / translation_scale with the paper fusion.
+  std::array<PaperScales, 2> paper{};
+  CalibrationMeta meta;
+
+  // The per-sensor calibrations for a fusion method (paper: with the [paper] scales).
+  std::array<dsp::Calibration, 2> for_method(dsp::FusionMethod method) const;
+};
+
+// Parses and validates TOML text. `origin` names the source in messages (a file path). On error
+// *out is left unchanged. Missing keys take the documented defaults (dsp::Calibration{});
+// unknown keys, wrong types and out-of-range values are errors naming the key.
+Status parse_calibration(std::string_view text, const std::string& origin,
+                         CalibrationSet* out) noexcept;
+
+// Reads and parses a file (see parse_calibration); errors name the file.
+Status load_calibration(const std::filesystem::path& file, CalibrationSet* out) noexcept;
+
+// Serialises a set (validated first) as TOML text; every key is written. False + *error on an
+// invalid set.
+bool format_calibration(const CalibrationSet& set, std::string* text, std::string* error) noexcept;
+
+// Validates and writes atomically (temporary file + rename), so a daemon never reads half a file.
+Status save_calibration(const std::filesystem::path& file, const CalibrationSet& set) noexcept;
+
+// Field-by-field validation with messages naming the key ("left.contact_tau_off"); also runs
+// dsp::validate on each sensor's calibration for both fusion methods.
+Status validate(const CalibrationSet& set, const std::string& origin) noexcept;
+
+// Text of the velocity proxy enum as written in the file ("velocity", "displacement").
+const char* proxy_name(dsp::VelocityProxy p) noexcept;
+bool parse_proxy_name(std::string_view name, dsp::VelocityProxy* out) noexcept;
+
+// Names of every key accepted in a sensor table, in file order (for docs and tests).
+std::vector<std::string> sensor_keys();
+
+}  // namespace tacse3::config

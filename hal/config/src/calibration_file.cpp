@@ -1,0 +1,727 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 config: TOML calibration file reader/writer with per-key validation (toml++, no throws).
+#include "tacse3/config/calibration_file.hpp"
+
+// Header-only toml++ without exceptions: parse errors come back as values, so nothing can escape
+// from a SIGHUP reload. Only this translation unit includes toml++.
+#define TOML_HEADER_ONLY 1
+#define TOML_EXCEPTIONS 0
+#define TOML_ENABLE_FORMATTERS 0
+// toml++ 3.3.0 asserts internal parser invariants that malformed input can break (a flipped byte
+// in a key: parser.inl parse_key). An assert would abort the daemon on a bad file, so the checks
+// are compiled out as in a release build; the parser then reports the malformed input as an error
+// (tests/tools/test_calibration_file.cpp flips every byte under ASan/UBSan).
+#define TOML_ASSERT(expr) static_assert(true)
+#include <toml++/toml.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <system_error>
+
+namespace tacse3::config {
+namespace {
+
+using dsp::Calibration;
+
+// One key of a sensor table: its member in dsp::Calibration and its documented range
+// (dsp/include/tacse3/dsp/calibration.hpp). lo_open / hi_open: the bound itself is excluded.
+struct Field {
+  enum Kind { kReal, kInt, kVec3, kProxy };
+  const char* key;
+  Kind kind;
+  double lo, hi;
+  bool lo_open, hi_open;
+  double Calibration::*real = nullptr;
+  int Calibration::*integer = nullptr;
+  std::array<double, 3> Calibration::*vec = nullptr;
+};
+
+constexpr double kInf = 1e300;
+
+const std::vector<Field>& fields() {
+  // The order is the file order. When dsp::Calibration gains a field (e.g. the slip detector
+  // thresholds of VelocityProxy::kAuto), one line here makes it readable and writable.
+  static const std::vector<Field> f = {
+      {"pixel_pitch_m", Field::kReal, 1e-6, 2e-4, false, false, &Calibration::pixel_pitch_m},
+      {"pixel_aspect_y", Field::kReal, 0.25, 4.0, false, false, &Calibration::pixel_aspect_y},
+      {"normal_gain_density", Field::kReal, 0.0, 1e4, false, false,
+       &Calibration::normal_gain_density},
+      {"normal_gain_divergence", Field::kReal, 0.0, 1e4, false, false,
+       &Calibration::normal_gain_divergence},
+      {"shear_gain_d", Field::kReal, 0.0, 1e4, false, false, &Calibration::shear_gain_d},
+      {"shear_gain_r", Field::kReal, 0.0, 1e4, false, false, &Calibration::shear_gain_r},
+      {"shear_gain_k", Field::kReal, 0.0, 1e4, false, false, &Calibration::shear_gain_k},
+      {"contact_tau_on", Field::kReal, 0.0, 1e4, true, false, &Calibration::contact_tau_on},
+      {"contact_tau_off", Field::kReal, 0.0, 1e4, false, false, &Calibration::contact_tau_off},
+      {"contact_min_area_cells", Field::kInt, 1, 1200, false, false, nullptr,
+       &Calibration::contact_min_area_cells},
+      {"height_gain_m", Field::kReal, 0.0, 1.0, false, false, &Calibration::height_gain_m},
+      {"height_max_m", Field::kReal, 0.0, 0.01, false, false, &Calibration::height_max_m},
+      {"velocity_proxy", Field::kProxy, 0, 0, false, false},
+      {"c_velocity", Field::kReal, 0.0, 100.0, true, false, &Calibration::c_velocity},
+      {"c_displacement", Field::kReal, 0.0, 1.0, true, false, &Calibration::c_displacement},
+      {"max_mask_change", Field::kReal, 0.0, 1.0, false, false, &Calibration::max_mask_change},
+      {"rotation_scale", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
+       &Calibration::rotation_scale},
+      {"translation_scale", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
+       &Calibration::translation_scale},
+      {"moving_average_length", Field::kInt, 1, dsp::kMaxMovingAverage, false, false, nullptr,
+       &Calibration::moving_average_length},
+      {"solve_lambda_rel", Field::kReal, 0.0, 1.0, false, false, &Calibration::solve_lambda_rel},
+      {"solve_lever_floor_m", Field::kReal, 0.0, 1e-2, false, false,
+       &Calibration::solve_lever_floor_m},
+      {"solve_rcond_min", Field::kReal, 0.0, 1.0, false, true, &Calibration::solve_rcond_min},
+  };
+  return f;
+}
+
+// Names of the proxy modes as written in the file. VelocityProxy::kAuto gets its line here.
+struct ProxyName {
+  dsp::VelocityProxy value;
+  const char* name;
+};
+constexpr ProxyName kProxyNames[] = {
+    {dsp::VelocityProxy::kVelocity, "velocity"},
+    {dsp::VelocityProxy::kDisplacement, "displacement"},
+};
+
+std::string fmt_real(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof(buf), v);
+  std::string s(buf, r.ptr);
+  // TOML needs a '.' or an exponent to read a float; integers are accepted too, but keep the
+  // written type unambiguous.
+  if (s.find_first_of(".eE") == std::string::npos && s.find_first_of("ni") == std::string::npos) {
+    s += ".0";
+  }
+  return s;
+}
+
+std::string range_text(const Field& f) {
+  std::string s = f.lo_open ? "(" : "[";
+  s += fmt_real(f.lo) + ", " + (f.hi >= kInf ? std::string("inf") : fmt_real(f.hi));
+  s += f.hi_open ? ")" : "]";
+  if (f.kind == Field::kInt) {
+    s = "[" + std::to_string(static_cast<long long>(f.lo)) + ", " +
+        std::to_string(static_cast<long long>(f.hi)) + "]";
+  }
+  return s;
+}
+
+bool in_range(const Field& f, double v) {
+  if (!std::isfinite(v)) return false;
+  if (f.lo_open ? !(v > f.lo) : !(v >= f.lo)) return false;
+  if (f.hi_open ? !(v < f.hi) : !(v <= f.hi)) return false;
+  return true;
+}
+
+std::string quote(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+          char buf[8];
+          std::snprintf(buf, sizeof(buf), "\\u%04x", static_cast<unsigned>(c));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+// "FILE:LINE: " prefix for a node (line only when toml++ knows it).
+std::string where(const std::string& origin, const toml::node& n) {
+  const auto& b = n.source().begin;
+  if (b.line > 0) return origin + ":" + std::to_string(b.line) + ": ";
+  return origin + ": ";
+}
+
+std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a float";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::table:
+      return "a table";
+    default:
+      return "a date/time";
+  }
+}
+
+// A real number: TOML float or integer.
+bool get_real(const toml::node& n, double* v) {
+  if (!n.is_floating_point() && !n.is_integer()) return false;
+  const std::optional<double> d = n.value<double>();
+  if (!d.has_value()) return false;
+  *v = *d;
+  return true;
+}
+
+std::string describe(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  return fmt_real(v);
+}
+
+// Applies one sensor-table key to `cal`. `path` is the dotted key for messages.
+Status apply_field(const Field& f, const toml::node& n, const std::string& path,
+                   const std::string& origin, Calibration* cal) {
+  const std::string at = where(origin, n) + "key \"" + path + "\" ";
+  switch (f.kind) {
+    case Field::kReal: {
+      double v = 0.0;
+      if (!get_real(n, &v)) return Status::error(at + "must be a number, got " + type_name(n));
+      if (!in_range(f, v)) {
+        return Status::error(at + "must be in " + range_text(f) + ", got " + describe(v));
+      }
+      cal->*(f.real) = v;
+      return {};
+    }
+    case Field::kInt: {
+      const auto* i = n.as_integer();
+      if (i == nullptr) return Status::error(at + "must be an integer, got " + type_name(n));
+      const auto v = i->get();
+      if (v < static_cast<std::int64_t>(f.lo) || v > static_cast<std::int64_t>(f.hi)) {
+        return Status::error(at + "must be an integer in " + range_text(f) + ", got " +
+                             std::to_string(v));
+      }
+      cal->*(f.integer) = static_cast<int>(v);
+      return {};
+    }
+    case Field::kVec3: {
+      const auto* a = n.as_array();
+      if (a == nullptr) {
+        return Status::error(at + "must be an array of 3 numbers, got " + type_name(n));
+      }
+      if (a->size() != 3) {
+        return Status::error(at + "must have 3 elements (x, y, z), got " +
+                             std::to_string(a->size()));
+      }
+      std::array<double, 3> v{};
+      for (std::size_t k = 0; k < 3; ++k) {
+        const toml::node* e = a->get(k);
+        if (e == nullptr || !get_real(*e, &v[k])) {
+          return Status::error(at + "element " + std::to_string(k) + " must be a number, got " +
+                               (e ? type_name(*e) : std::string("nothing")));
+        }
+        if (!in_range(f, v[k])) {
+          return Status::error(at + "element " + std::to_string(k) + " must be in " +
+                               range_text(f) + ", got " + describe(v[k]));
+        }
+      }
+      cal->*(f.vec) = v;
+      return {};
+    }
+    case Field::kProxy: {
+      const auto* s = n.as_string();
+      if (s == nullptr) return Status::error(at + "must be a string, got " + type_name(n));
+      dsp::VelocityProxy p{};
+      if (!parse_proxy_name(s->get(), &p)) {
+        std::string names;
+        for (const auto& pn : kProxyNames)
+          names += std::string(names.empty() ? "" : ", ") + pn.name;
+        return Status::error(at + "must be one of " + names + ", got \"" + s->get() + "\"");
+      }
+      cal->velocity_proxy = p;
+      return {};
+    }
+  }
+  return Status::error(at + "has an unknown kind");
+}
+
+const Field* find_field(std::string_view key) {
+  for (const auto& f : fields()) {
+    if (key == f.key) return &f;
+  }
+  return nullptr;
+}
+
+std::string unknown_key_message(const std::string& origin, const toml::node& n,
+                                const std::string& path, const std::string& allowed) {
+  return where(origin, n) + "unknown key \"" + path + "\" (allowed here: " + allowed + ")";
+}
+
+std::string sensor_key_list() {
+  std::string s;
+  for (const auto& f : fields()) s += std::string(s.empty() ? "" : ", ") + f.key;
+  return s;
+}
+
+// Applies a sensor table ([sensor], [left], [right]) to the calibrations in `targets`.
+Status apply_sensor_table(const toml::table& t, const std::string& name, const std::string& origin,
+                          const std::vector<Calibration*>& targets) {
+  for (auto&& [k, v] : t) {
+    const std::string key(k.str());
+    const std::string path = name + "." + key;
+    const Field* f = find_field(key);
+    if (f == nullptr) {
+      return Status::error(unknown_key_message(origin, v, path, sensor_key_list()));
+    }
+    for (Calibration* c : targets) {
+      if (Status s = apply_field(*f, v, path, origin, c); !s) return s;
+    }
+  }
+  return {};
+}
+
+Status apply_paper_keys(const toml::table& t, const std::string& name, const std::string& origin,
+                        const std::vector<PaperScales*>& targets, bool allow_subtables) {
+  static const Field& rot = *find_field("rotation_scale");
+  for (auto&& [k, v] : t) {
+    const std::string key(k.str());
+    const std::string path = name + "." + key;
+    if (allow_subtables && (key == "left" || key == "right")) continue;
+    if (key != "rotation_scale" && key != "translation_scale") {
+      return Status::error(unknown_key_message(
+          origin, v, path,
+          allow_subtables ? "rotation_scale, translation_scale, [paper.left], [paper.right]"
+                          : "rotation_scale, translation_scale"));
+    }
+    for (PaperScales* p : targets) {
+      Calibration scratch;
+      if (Status s = apply_field(rot, v, path, origin, &scratch); !s) return s;
+      (key == "rotation_scale" ? p->rotation_scale : p->translation_scale) = scratch.rotation_scale;
+    }
+  }
+  return {};
+}
+
+Status parse_meta(const toml::table& t, const std::string& origin, CalibrationMeta* meta) {
+  for (auto&& [k, v] : t) {
+    const std::string key(k.str());
+    const std::string path = "meta." + key;
+    if (key == "generator" || key == "created" || key == "note") {
+      const auto* s = v.as_string();
+      if (s == nullptr) {
+        return Status::error(where(origin, v) + "key \"" + path + "\" must be a string, got " +
+                             type_name(v));
+      }
+      (key == "generator" ? meta->generator
+       : key == "created" ? meta->created
+                          : meta->note) = s->get();
+    } else if (key == "recordings") {
+      const auto* a = v.as_array();
+      if (a == nullptr) {
+        return Status::error(where(origin, v) + "key \"" + path +
+                             "\" must be an array of strings, got " + type_name(v));
+      }
+      meta->recordings.clear();
+      for (const auto& e : *a) {
+        const auto* s = e.as_string();
+        if (s == nullptr) {
+          return Status::error(where(origin, e) + "key \"" + path +
+                               "\" must hold only strings, got " + type_name(e));
+        }
+        meta->recordings.push_back(s->get());
+      }
+    } else {
+      return Status::error(
+          unknown_key_message(origin, v, path, "generator, created, note, recordings"));
+    }
+  }
+  return {};
+}
+
+const toml::table* sub_table(const toml::table& root, std::string_view key,
+                             const std::string& origin, const std::string& path, Status* err) {
+  const toml::node* n = root.get(key);
+  if (n == nullptr) return nullptr;
+  const auto* t = n->as_table();
+  if (t == nullptr) {
+    *err = Status::error(where(origin, *n) + "key \"" + path + "\" must be a table, got " +
+                         type_name(*n));
+  }
+  return t;
+}
+
+Status parse_impl(std::string_view text, const std::string& origin, CalibrationSet* out) {
+  toml::parse_result parsed = toml::parse(text, origin);
+  if (!parsed) {
+    const toml::parse_error& e = parsed.error();
+    const auto& b = e.source().begin;
+    return Status::error(origin + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) +
+                         ": TOML syntax error: " + std::string(e.description()));
+  }
+  const toml::table& root = parsed.table();
+
+  // format and version first: a file of another kind or a newer version is reported as such
+  // rather than as a pile of unknown keys.
+  const toml::node* fmt = root.get("format");
+  if (fmt == nullptr) {
+    return Status::error(origin + ": missing required key \"format\" (must be \"" +
+                         std::string(kCalibrationFormat) + "\")");
+  }
+  if (fmt->as_string() == nullptr || fmt->as_string()->get() != kCalibrationFormat) {
+    return Status::error(where(origin, *fmt) + "key \"format\" must be \"" +
+                         std::string(kCalibrationFormat) + "\"" +
+                         (fmt->as_string() ? ", got \"" + fmt->as_string()->get() + "\""
+                                           : ", got " + type_name(*fmt)));
+  }
+  const toml::node* ver = root.get("version");
+  if (ver == nullptr) {
+    return Status::error(origin + ": missing required key \"version\" (must be " +
+                         std::to_string(kCalibrationVersion) + ")");
+  }
+  if (ver->as_integer() == nullptr) {
+    return Status::error(where(origin, *ver) + "key \"version\" must be an integer, got " +
+                         type_name(*ver));
+  }
+  if (ver->as_integer()->get() != kCalibrationVersion) {
+    return Status::error(where(origin, *ver) + "version " +
+                         std::to_string(ver->as_integer()->get()) +
+                         " is not supported (this reader knows version " +
+                         std::to_string(kCalibrationVersion) + ")");
+  }
+  for (auto&& [k, v] : root) {
+    const std::string key(k.str());
+    if (key != "format" && key != "version" && key != "meta" && key != "sensor" && key != "left" &&
+        key != "right" && key != "paper") {
+      return Status::error(unknown_key_message(
+          origin, v, key, "format, version, [meta], [sensor], [left], [right], [paper]"));
+    }
+  }
+
+  CalibrationSet set;  // defaults
+  Status err;
+  if (const auto* t = sub_table(root, "meta", origin, "meta", &err)) {
+    if (Status s = parse_meta(*t, origin, &set.meta); !s) return s;
+  }
+  if (!err) return err;
+  if (const auto* t = sub_table(root, "sensor", origin, "sensor", &err)) {
+    if (Status s =
+            apply_sensor_table(*t, "sensor", origin, {&set.sensor[kLeft], &set.sensor[kRight]});
+        !s) {
+      return s;
+    }
+  }
+  if (!err) return err;
+  const char* names[2] = {"left", "right"};
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (const auto* t = sub_table(root, names[i], origin, names[i], &err)) {
+      if (Status s = apply_sensor_table(*t, names[i], origin, {&set.sensor[i]}); !s) return s;
+    }
+    if (!err) return err;
+  }
+  // Paper scales default to the (merged) sensor scales, then [paper], then [paper.left/right].
+  for (std::size_t i = 0; i < 2; ++i) {
+    set.paper[i].rotation_scale = set.sensor[i].rotation_scale;
+    set.paper[i].translation_scale = set.sensor[i].translation_scale;
+  }
+  if (const auto* t = sub_table(root, "paper", origin, "paper", &err)) {
+    if (Status s =
+            apply_paper_keys(*t, "paper", origin, {&set.paper[kLeft], &set.paper[kRight]}, true);
+        !s) {
+      return s;
+    }
+    for (std::size_t i = 0; i < 2; ++i) {
+      const std::string path = std::string("paper.") + names[i];
+      if (const auto* st = sub_table(*t, names[i], origin, path, &err)) {
+        if (Status s = apply_paper_keys(*st, path, origin, {&set.paper[i]}, false); !s) return s;
+      }
+      if (!err) return err;
+    }
+  }
+  if (!err) return err;
+  if (Status s = validate(set, origin); !s) return s;
+  *out = std::move(set);
+  return {};
+}
+
+bool same(const Calibration& a, const Calibration& b, const Field& f) {
+  switch (f.kind) {
+    case Field::kReal:
+      return a.*(f.real) == b.*(f.real);
+    case Field::kInt:
+      return a.*(f.integer) == b.*(f.integer);
+    case Field::kVec3:
+      return a.*(f.vec) == b.*(f.vec);
+    case Field::kProxy:
+      return a.velocity_proxy == b.velocity_proxy;
+  }
+  return false;
+}
+
+std::string value_text(const Calibration& c, const Field& f) {
+  switch (f.kind) {
+    case Field::kReal:
+      return fmt_real(c.*(f.real));
+    case Field::kInt:
+      return std::to_string(c.*(f.integer));
+    case Field::kVec3: {
+      const auto& v = c.*(f.vec);
+      return "[" + fmt_real(v[0]) + ", " + fmt_real(v[1]) + ", " + fmt_real(v[2]) + "]";
+    }
+    case Field::kProxy:
+      return quote(proxy_name(c.velocity_proxy));
+  }
+  return "";
+}
+
+std::string vec_text(const std::array<double, 3>& v) {
+  return "[" + fmt_real(v[0]) + ", " + fmt_real(v[1]) + ", " + fmt_real(v[2]) + "]";
+}
+
+}  // namespace
+
+const char* proxy_name(dsp::VelocityProxy p) noexcept {
+  for (const auto& pn : kProxyNames) {
+    if (pn.value == p) return pn.name;
+  }
+  return "unknown";
+}
+
+bool parse_proxy_name(std::string_view name, dsp::VelocityProxy* out) noexcept {
+  for (const auto& pn : kProxyNames) {
+    if (name == pn.name) {
+      *out = pn.value;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::vector<std::string> sensor_keys() {
+  std::vector<std::string> k;
+  for (const auto& f : fields()) k.emplace_back(f.key);
+  return k;
+}
+
+std::array<dsp::Calibration, 2> CalibrationSet::for_method(dsp::FusionMethod method) const {
+  std::array<dsp::Calibration, 2> c = sensor;
+  if (method == dsp::FusionMethod::kPaper) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      c[i].rotation_scale = paper[i].rotation_scale;
+      c[i].translation_scale = paper[i].translation_scale;
+    }
+  }
+  return c;
+}
+
+Status validate(const CalibrationSet& set, const std::string& origin) noexcept {
+  try {
+    const char* names[2] = {"left", "right"};
+    for (std::size_t i = 0; i < 2; ++i) {
+      const Calibration& c = set.sensor[i];
+      for (const auto& f : fields()) {
+        const std::string at = origin + ": key \"" + names[i] + "." + f.key + "\" ";
+        switch (f.kind) {
+          case Field::kReal:
+            if (!in_range(f, c.*(f.real))) {
+              return Status::error(at + "must be in " + range_text(f) + ", got " +
+                                   describe(c.*(f.real)));
+            }
+            break;
+          case Field::kInt:
+            if (!in_range(f, c.*(f.integer))) {
+              return Status::error(at + "must be an integer in " + range_text(f) + ", got " +
+                                   std::to_string(c.*(f.integer)));
+            }
+            break;
+          case Field::kVec3:
+            for (double v : c.*(f.vec)) {
+              if (!in_range(f, v)) {
+                return Status::error(at + "elements must be in " + range_text(f) + ", got " +
+                                     describe(v));
+              }
+            }
+            break;
+          case Field::kProxy: {
+            dsp::VelocityProxy p{};
+            if (!parse_proxy_name(proxy_name(c.velocity_proxy), &p)) {
+              return Status::error(at + "has an unknown value " +
+                                   std::to_string(static_cast<int>(c.velocity_proxy)));
+            }
+            break;
+          }
+        }
+      }
+      if (c.contact_tau_off > c.contact_tau_on) {
+        return Status::error(origin + ": key \"" + names[i] + ".contact_tau_off\" (" +
+                             fmt_real(c.contact_tau_off) + ") must not exceed \"" + names[i] +
+                             ".contact_tau_on\" (" + fmt_real(c.contact_tau_on) + ")");
+      }
+      const Field& rot = *find_field("rotation_scale");
+      for (const auto* v : {&set.paper[i].rotation_scale, &set.paper[i].translation_scale}) {
+        for (double x : *v) {
+          if (!in_range(rot, x)) {
+            return Status::error(
+                origin + ": key \"paper." + names[i] + "." +
+                (v == &set.paper[i].rotation_scale ? "rotation_scale" : "translation_scale") +
+                "\" elements must be in " + range_text(rot) + ", got " + describe(x));
+          }
+        }
+      }
+    }
+    // The pipeline's own check, for both fusion methods (catches any rule added in dsp/).
+    for (auto method : {dsp::FusionMethod::kJoint, dsp::FusionMethod::kPaper}) {
+      const auto cals = set.for_method(method);
+      for (std::size_t i = 0; i < 2; ++i) {
+        if (dsp::validate(cals[i]) != dsp::Status::kOk) {
+          return Status::error(origin + ": the " + names[i] +
+                               " calibration is rejected by dsp::validate (" +
+                               dsp::to_string(dsp::validate(cals[i])) + ")");
+        }
+      }
+    }
+    return {};
+  } catch (...) {
+    return Status::error(origin + ": out of memory while validating");
+  }
+}
+
+Status parse_calibration(std::string_view text, const std::string& origin,
+                         CalibrationSet* out) noexcept {
+  if (out == nullptr) return Status::error(origin + ": null output");
+  try {
+    return parse_impl(text, origin, out);
+  } catch (const std::exception& e) {
+    return Status::error(origin + ": " + e.what());
+  } catch (...) {
+    return Status::error(origin + ": unexpected error while parsing");
+  }
+}
+
+Status load_calibration(const std::filesystem::path& file, CalibrationSet* out) noexcept {
+  try {
+    const std::string origin = file.string();
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec)) return Status::error(origin + ": no such file");
+    if (std::filesystem::is_directory(file, ec)) {
+      return Status::error(origin + ": is a directory, expected a calibration file");
+    }
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return Status::error(origin + ": cannot open for reading");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) return Status::error(origin + ": read error");
+    const std::string text = ss.str();
+    if (text.size() > (1u << 20)) {
+      return Status::error(origin + ": file is larger than 1 MiB; not a calibration file");
+    }
+    return parse_calibration(text, origin, out);
+  } catch (...) {
+    return Status::error(file.string() + ": unexpected error while reading");
+  }
+}
+
+bool format_calibration(const CalibrationSet& set, std::string* text, std::string* error) noexcept {
+  try {
+    if (Status s = validate(set, "calibration"); !s) {
+      if (error) *error = s.message();
+      return false;
+    }
+    std::string o;
+    o += "# tacse3 calibration file, format version 1 (docs/calibration.md).\n";
+    o += "# Units are SI. [sensor] applies to both pads; [left] / [right] override single keys.\n";
+    o += "format = " + quote(kCalibrationFormat) + "\n";
+    o += "version = " + std::to_string(kCalibrationVersion) + "\n\n";
+    o += "[meta]\n";
+    o += "generator = " + quote(set.meta.generator) + "\n";
+    o += "created = " + quote(set.meta.created) + "\n";
+    o += "note = " + quote(set.meta.note) + "\n";
+    o += "recordings = [";
+    for (std::size_t i = 0; i < set.meta.recordings.size(); ++i) {
+      o += (i ? ", " : "") + quote(set.meta.recordings[i]);
+    }
+    o += "]\n\n";
+    const Calibration& l = set.sensor[kLeft];
+    const Calibration& r = set.sensor[kRight];
+    o += "[sensor]\n";
+    for (const auto& f : fields()) {
+      if (same(l, r, f)) o += std::string(f.key) + " = " + value_text(l, f) + "\n";
+    }
+    const char* names[2] = {"left", "right"};
+    for (std::size_t i = 0; i < 2; ++i) {
+      o += std::string("\n[") + names[i] + "]\n";
+      for (const auto& f : fields()) {
+        if (!same(l, r, f)) o += std::string(f.key) + " = " + value_text(set.sensor[i], f) + "\n";
+      }
+    }
+    o += "\n# Per-axis scales used instead of the ones above with the paper fusion (--method "
+         "paper).\n[paper]\n";
+    const PaperScales& pl = set.paper[kLeft];
+    const PaperScales& pr = set.paper[kRight];
+    if (pl.rotation_scale == pr.rotation_scale) {
+      o += "rotation_scale = " + vec_text(pl.rotation_scale) + "\n";
+    }
+    if (pl.translation_scale == pr.translation_scale) {
+      o += "translation_scale = " + vec_text(pl.translation_scale) + "\n";
+    }
+    for (std::size_t i = 0; i < 2; ++i) {
+      o += std::string("\n[paper.") + names[i] + "]\n";
+      if (pl.rotation_scale != pr.rotation_scale) {
+        o += "rotation_scale = " + vec_text(set.paper[i].rotation_scale) + "\n";
+      }
+      if (pl.translation_scale != pr.translation_scale) {
+        o += "translation_scale = " + vec_text(set.paper[i].translation_scale) + "\n";
+      }
+    }
+    *text = std::move(o);
+    return true;
+  } catch (...) {
+    if (error) *error = "out of memory while formatting the calibration";
+    return false;
+  }
+}
+
+Status save_calibration(const std::filesystem::path& file, const CalibrationSet& set) noexcept {
+  try {
+    const std::string origin = file.string();
+    std::string text, error;
+    if (!format_calibration(set, &text, &error)) return Status::error(origin + ": " + error);
+    // Round trip: the writer must produce a file the reader accepts and reads back identically.
+    CalibrationSet back;
+    if (Status s = parse_calibration(text, origin, &back); !s) {
+      return Status::error("internal error: written calibration does not parse: " + s.message());
+    }
+    std::filesystem::path tmp = file;
+    tmp += ".tmp";
+    {
+      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+      if (!out) return Status::error(tmp.string() + ": cannot open for writing");
+      out << text;
+      out.flush();
+      if (!out) return Status::error(tmp.string() + ": write error");
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, file, ec);
+    if (ec) {
+      std::filesystem::remove(tmp, ec);
+      return Status::error(origin + ": cannot rename the temporary file into place");
+    }
+    return {};
+  } catch (...) {
+    return Status::error(file.string() + ": unexpected error while writing");
+  }
+}
+
+}  // namespace tacse3::config
