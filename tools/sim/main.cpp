@@ -11,9 +11,10 @@
 #include <vector>
 
 #include "options.hpp"
-#include "progress.hpp"
 #include "tacse3/recording/recording.hpp"
 #include "tacse3/sim/simulator.hpp"
+#include "tacse3/tools/progress.hpp"
+#include "tacse3/tools/sim_source.hpp"
 
 namespace {
 
@@ -172,20 +173,8 @@ int main(int argc, char** argv) {
         abort = true;
         return;
       }
-      const sim::PadLabels& pl = simulator->labels(s);
-      rec::SimLabel& l =
-          labels[slot * static_cast<std::size_t>(frames) + static_cast<std::size_t>(i)];
-      l.index = i;
-      l.t_ns = t;
-      l.sensor = static_cast<rec::SensorId>(s);
-      l.phase = sim::to_string(scn.phase(sim::Simulator::seconds(t)));
-      l.in_contact = pl.in_contact;
-      l.slipping = pl.slipping;
-      l.slip_fraction = pl.slip_fraction;
-      l.area_mm2 = pl.area_mm2;
-      l.centroid_u_mm = pl.centroid_mm.x();
-      l.centroid_v_mm = pl.centroid_mm.y();
-      l.peak_depth_mm = pl.peak_depth_mm;
+      labels[slot * static_cast<std::size_t>(frames) + static_cast<std::size_t>(i)] =
+          tacse3::tools::sim_label(*simulator, s, i, t);
       ++done;
     }
   };

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3-sim: terminal progress bar implementation.
-#include "progress.hpp"
+// tacse3 tools: terminal progress bar implementation.
+#include "tacse3/tools/progress.hpp"
 
 #include <unistd.h>
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3-sim: a one-line progress bar on stderr, shown only when stderr is a terminal.
+// tacse3 tools: a one-line progress bar on stderr, shown only when stderr is a terminal.
 #pragma once
 
 #include <chrono>

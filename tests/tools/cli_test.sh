@@ -1,0 +1,58 @@
+#!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
+# Scripted CLI tests of tacse3-replay and tacse3-calibrate: exit codes, messages, output files.
+# Usage: cli_test.sh BIN_DIR (the build's tools/ folder)
+set -u
+BIN="$1"
+SIM="$BIN/sim/tacse3-sim"
+REPLAY="$BIN/replay/tacse3-replay"
+CAL="$BIN/calibrate/tacse3-calibrate"
+T="${TMPDIR:-/tmp}/tacse3_cli_test.$$"
+mkdir -p "$T"
+trap 'rm -rf "$T"' EXIT
+fails=0
+check() {  # check NAME CONDITION...
+  name="$1"; shift
+  if "$@"; then echo "ok   $name"; else echo "FAIL $name"; fails=$((fails + 1)); fi
+}
+contains() { grep -q -- "$2" "$1"; }
+
+"$SIM" -q --out "$T/rec" --object sphere --motion rz --magnitude 2 --colour grey \
+  --approach-s 0.05 --grasp-s 0.2 --settle-s 0.05 --hold-s 0.1 || { echo "FAIL tacse3-sim"; exit 1; }
+frames=$(($(wc -l < "$T/rec/frames.csv") - 1))
+
+"$REPLAY" "$T/rec" --out "$T/out.csv" > "$T/stdout" 2> "$T/stderr"
+check "replay exits 0" test $? -eq 0
+check "replay CSV header" test "$(head -1 "$T/out.csv")" = \
+  "t_ns,wx,wy,wz,vx,vy,vz,qw,qx,qy,qz,px,py,pz,valid_left,valid_right"
+check "replay CSV rows = frames" test "$(($(wc -l < "$T/out.csv") - 1))" -eq "$frames"
+check "replay summary has the rotation" contains "$T/stdout" "rotation: *estimated"
+check "replay summary has the truth" contains "$T/stdout" "truth *2.00 deg"
+
+"$REPLAY" "$T/rec" --out - --method paper --mode displacement --sensors left -q > "$T/o2" 2>&1
+check "replay to stdout" test "$(($(wc -l < "$T/o2") - 1))" -eq "$frames"
+
+"$REPLAY" "$T/nope" --out "$T/x.csv" > /dev/null 2> "$T/e1"
+check "missing recording exits 1" test $? -eq 1
+check "missing recording is named" contains "$T/e1" "$T/nope"
+
+printf 'format = "tacse3-calibration"\nversion = 1\n[sensor]\nc_velocty = 0.01\n' > "$T/bad.toml"
+"$REPLAY" "$T/rec" --calibration "$T/bad.toml" --out "$T/x.csv" > /dev/null 2> "$T/e2"
+check "bad calibration exits 1" test $? -eq 1
+check "bad calibration names file and key" contains "$T/e2" "bad.toml:4: unknown key \"sensor.c_velocty\""
+
+"$REPLAY" "$T/rec" --out "$T/x.csv" --mode fast > /dev/null 2> "$T/e3"
+check "bad --mode is refused" test $? -ne 0
+check "bad --mode is named" contains "$T/e3" "mode"
+
+"$REPLAY" > /dev/null 2>&1
+check "no arguments is an error" test $? -ne 0
+
+rm "$T/rec/truth.csv"
+"$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"
+check "calibrate without truth exits 1" test $? -eq 1
+check "calibrate names truth.csv" contains "$T/e4" "truth.csv"
+check "no calibration file written" test ! -e "$T/cal.toml"
+
+[ "$fails" -eq 0 ] || { echo "$fails check(s) failed"; exit 1; }
+echo "all CLI checks passed"

@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tools: simulated accuracy cases: scenario specs, calibration, evaluation per config.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tacse3/sim/simulator.hpp"
+#include "tacse3/tools/calibrate.hpp"
+#include "tacse3/tools/replay.hpp"
+
+namespace tacse3::tools {
+
+// One simulated recording, described like a tacse3-sim command line.
+struct SimCase {
+  std::string object = "sphere";  // preset name (tacse3-sim --object)
+  std::string motion = "rz";      // rx, ry, rz, tx, ty
+  double magnitude = 30.0;        // deg or mm
+  std::uint64_t seed = 1;
+  double radius_mm = 0.0;  // 0 = the preset's size
+  double indentation_mm = 1.0;
+  double hold_s = 0.4;  // hold after the motion
+  double approach_s = 0.1, grasp_s = 0.4, settle_s = 0.1;
+  std::string label() const;  // "sphere rz 30"
+  // The equivalent tacse3-sim options (for docs and messages).
+  std::string sim_arguments() const;
+};
+
+// The simulator configuration tacse3-sim would use for the case (both sensors).
+std::string make_sim_config(const SimCase& c, sim::SimConfig* out);
+
+// A configuration evaluated on a case.
+struct EvalConfig {
+  dsp::FusionMethod method = dsp::FusionMethod::kJoint;
+  ProxyMode mode = ProxyMode::kAuto;
+  SensorChoice sensors = SensorChoice::kBoth;
+  bool reference = false;  // also run dsp_ref::DualPipelineRef (double) in lock step
+};
+
+struct EvalResult {
+  PoseErrors errors{};
+  std::optional<double> reference_error_deg;     // the double reference's final rotation error
+  std::optional<double> fixed_vs_reference_deg;  // angle between the two final orientations
+  std::optional<double> reference_translation_error_mm;
+  SlipScore slip{};
+  bool slip_scored = false;
+};
+
+// Renders the case once (in memory, grey) and runs every config in lock step.
+std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
+                          const std::vector<EvalConfig>& configs, std::vector<EvalResult>* out,
+                          std::atomic<std::int64_t>* frames_done = nullptr);
+
+// Calibrates on simulated cases (rendered in memory, grey) with tacse3-calibrate's fit.
+std::string calibrate_cases(const std::vector<SimCase>& cases, const CalibrateOptions& options,
+                            CalibrateReport* report);
+
+// Writes the case as a recording directory, like tacse3-sim (grey or RGB PNGs, truth.csv,
+// sim_labels.csv, recording.json with a "sim" block holding the regime). `sensors` selects the
+// recorded pads.
+std::string write_case_recording(const SimCase& c, const std::filesystem::path& dir, int channels,
+                                 SensorChoice sensors = SensorChoice::kBoth);
+
+// Frames the case renders (for progress bars).
+std::int64_t case_frames(const SimCase& c);
+
+}  // namespace tacse3::tools

@@ -1,0 +1,60 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tools: fits a calibration from recordings with truth by running the pipeline (calibrate).
+#pragma once
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "tacse3/config/calibration_file.hpp"
+#include "tacse3/tools/replay.hpp"
+#include "tacse3/tools/source.hpp"
+
+namespace tacse3::tools {
+
+struct CalibrateOptions {
+  config::CalibrationSet start{};  // starting values (the documented defaults)
+  int jobs = 1;                    // recordings processed in parallel (one thread each)
+  bool progress = false;           // progress bar on stderr
+  std::function<void(const std::string&)> log;  // stage messages (may be empty)
+};
+
+// What the fit says about one recording.
+struct RecordingFit {
+  std::string name;
+  Eigen::Vector3d truth_rotation_deg = Eigen::Vector3d::Zero();  // final truth rotation vector
+  double truth_translation_mm = 0.0;
+  ProxyMode explained_by = ProxyMode::kVelocity;  // proxy whose calibrated estimate fits best
+  std::string sim_regime;  // "stick"/"slide" from recording.json's "sim" block: REPORT ONLY
+  // Velocity-proxy rate left at rest / rate in motion (-1: not measurable); decides the proxy.
+  double rest_persistence = -1.0;
+  double before_deg = 0.0;            // joint, starting calibration, that proxy: rotation error
+  double after_deg = 0.0;             // joint, fitted calibration, that proxy (measured)
+  double after_other_deg = 0.0;       // joint, fitted calibration, the other proxy (measured)
+  double after_paper_deg = 0.0;       // paper fusion, fitted paper scales (linear prediction)
+  double translation_after_mm = 0.0;  // joint, fitted (translation scales applied linearly)
+};
+
+struct CalibrateReport {
+  config::CalibrationSet calibration;
+  std::vector<RecordingFit> recordings;
+  double fz_noise_sigma = 0.0;  // robust σ of filter(f^z) over all valid grid points (τ fit)
+  double fz_contact_p999 = 0.0;
+  std::array<double, 3> shear_gains{0.0, 1.0, 1.0};  // fitted (d, r, k), max = 1
+  std::array<int, 2> recordings_per_mode{0, 0};      // [velocity, displacement]
+  int iterations = 0;
+  std::vector<std::string> notes;  // sanity bounds hit, parts not fitted
+};
+
+// Runs the pipeline over every source in three stages (τ from the f^z noise; the shear gains,
+// both proxy gains and the per-axis rotation scales from component-wise runs; validation runs
+// that also fit the paper fusion's scales and the translation scales). Sources must carry truth.
+// Returns an empty string or an error naming the recording.
+std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateOptions& options,
+                      CalibrateReport* report);
+
+// Human-readable fit quality (one line per recording plus the fitted values).
+std::string format_report(const CalibrateReport& report);
+
+}  // namespace tacse3::tools

@@ -1,0 +1,799 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tools: calibration fit: τ from the f^z noise, gains and scales by least squares on
+// integrated rotations against the truth, all from runs of the real fixed-point pipeline.
+#include "tacse3/tools/calibrate.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <mutex>
+#include <numbers>
+#include <thread>
+
+#include "tacse3/tools/progress.hpp"
+
+namespace tacse3::tools {
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+constexpr double kQ16 = 1.0 / 65536.0;
+constexpr int kModes = 2;       // 0 = velocity proxy, 1 = displacement proxy
+constexpr int kComponents = 3;  // shear from d, r, k
+// Rotations below this count as "no rotation" in the relative weights (a translation or a tiny
+// stick motion still has its drift weighed, against 3 degrees).
+constexpr double kWeightFloorRad = 3.0 / kDeg;
+// Sanity bounds of the joint fusion's per-axis rotation scales: that fusion is in rad/s with the
+// physical lever arm, so a scale far from 1 would only fit noise.
+constexpr double kJointScaleMin = 0.5, kJointScaleMax = 2.0;
+// After this many iterations the proxy assignment is frozen (the alternation may otherwise cycle
+// between two assignments); the gains then converge for that assignment.
+constexpr int kFreezeAssignmentAfter = 20;
+// A recording is explained by the velocity proxy if less than this share of its velocity-proxy
+// rate persists at rest (rest_persistence).
+constexpr double kRestPersistenceMax = 0.5;
+// Ridge weight pulling the shear gains towards the starting ones, relative to the data term's
+// mean curvature (the three gains are nearly collinear on few recordings).
+constexpr double kShearRidge = 0.1;
+
+ProxyMode mode_of(int m) {
+  return m == 0 ? ProxyMode::kVelocity : ProxyMode::kDisplacement;
+}
+
+// ---- one pass: K engines in lock step over one source ----------------------------------------
+struct RunOutput {
+  Eigen::Vector3d rot_integral = Eigen::Vector3d::Zero();  // Σ ω̄ Δt, rad (what is integrated)
+  dsp::Pose final_pose{};
+  std::vector<Eigen::Vector3d> omega;  // per-frame ω̄ (kept when asked for)
+};
+
+// Histogram of filter(f^z) over valid grid points (stage 0).
+struct FzHistogram {
+  static constexpr double kLo = -0.25, kHi = 0.25, kBin = 1e-4;  // all values, for the noise
+  static constexpr double kPosHi = 4.0, kPosBin = 1e-3;          // positive values, for p99.9
+  std::vector<std::int64_t> all =
+      std::vector<std::int64_t>(static_cast<std::size_t>((kHi - kLo) / kBin) + 1, 0);
+  std::vector<std::int64_t> pos =
+      std::vector<std::int64_t>(static_cast<std::size_t>(kPosHi / kPosBin) + 1, 0);
+  std::int64_t n = 0, npos = 0;
+  void add(double v) {
+    const double c = std::clamp(v, kLo, kHi);
+    ++all[static_cast<std::size_t>((c - kLo) / kBin)];
+    ++n;
+    if (v > 0.0) {
+      ++pos[static_cast<std::size_t>(std::min(v, kPosHi) / kPosBin)];
+      ++npos;
+    }
+  }
+  void merge(const FzHistogram& o) {
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] += o.all[i];
+    for (std::size_t i = 0; i < pos.size(); ++i) pos[i] += o.pos[i];
+    n += o.n;
+    npos += o.npos;
+  }
+  static double quantile(const std::vector<std::int64_t>& h, std::int64_t total, double q,
+                         double lo, double bin) {
+    if (total == 0) return 0.0;
+    const auto target = static_cast<std::int64_t>(q * static_cast<double>(total));
+    std::int64_t acc = 0;
+    for (std::size_t i = 0; i < h.size(); ++i) {
+      acc += h[i];
+      if (acc > target) return lo + (static_cast<double>(i) + 0.5) * bin;
+    }
+    return lo + static_cast<double>(h.size()) * bin;
+  }
+  double median() const { return quantile(all, n, 0.5, kLo, kBin); }
+  // 1.4826 · median |v − median|: σ of the background noise (most grid points see no contact).
+  double mad_sigma() const {
+    const double med = median();
+    std::vector<std::int64_t> dev(all.size(), 0);
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const double v = kLo + (static_cast<double>(i) + 0.5) * kBin;
+      dev[std::min(dev.size() - 1, static_cast<std::size_t>(std::abs(v - med) / kBin))] += all[i];
+    }
+    return 1.4826 * quantile(dev, n, 0.5, 0.0, kBin);
+  }
+  double positive_quantile(double q) const { return quantile(pos, npos, q, 0.0, kPosBin); }
+};
+
+std::string run_pass(FrameSource& src, const std::vector<ReplayOptions>& configs,
+                     std::atomic<std::int64_t>* done, FzHistogram* hist,
+                     std::vector<RunOutput>* out, bool keep_omega = false) {
+  const SourceInfo& info = src.info();
+  std::vector<std::unique_ptr<Replayer>> engines;
+  for (const auto& c : configs) {
+    engines.push_back(std::make_unique<Replayer>());
+    if (std::string e = engines.back()->init(info, c); !e.empty()) return e;
+  }
+  out->assign(configs.size(), RunOutput{});
+  FrameResult r;
+  for (std::size_t i = 0; i < info.frame_count(); ++i) {
+    std::array<const dsp::FrameView*, 2> views{};
+    if (std::string e = src.read(i, &views); !e.empty()) return e;
+    for (std::size_t k = 0; k < engines.size(); ++k) {
+      if (std::string e = engines[k]->step_views(views, info.t_ns[i], i, &r); !e.empty()) return e;
+      (*out)[k].rot_integral += r.twist.head<3>() * r.dt_s;
+      (*out)[k].final_pose = r.pose;
+      if (keep_omega) (*out)[k].omega.push_back(r.twist.head<3>());
+    }
+    if (hist != nullptr) {
+      for (std::size_t s = 0; s < 2; ++s) {
+        if (views[s] == nullptr) continue;
+        const dsp::SensorFields& f =
+            engines[0]->pipeline().sensor(static_cast<dsp::SensorSlot>(s)).fields();
+        for (std::size_t g = 0; g < static_cast<std::size_t>(dsp::kGridCount); ++g) {
+          if (f.smoothed_valid.v[g] != 0) hist->add(f.contact.fz_filtered.v[g] * kQ16);
+        }
+      }
+    }
+    if (done != nullptr) ++*done;
+  }
+  return {};
+}
+
+// Runs `job(i)` for every recording on `jobs` threads; the first error wins.
+std::string for_each_recording(std::size_t n, int jobs,
+                               const std::function<std::string(std::size_t)>& job) {
+  std::atomic<std::size_t> next{0};
+  std::mutex m;
+  std::string first_error;
+  auto worker = [&] {
+    for (;;) {
+      const std::size_t i = next++;
+      if (i >= n) return;
+      {
+        std::lock_guard<std::mutex> lock(m);
+        if (!first_error.empty()) return;
+      }
+      std::string e = job(i);
+      if (!e.empty()) {
+        std::lock_guard<std::mutex> lock(m);
+        if (first_error.empty()) first_error = e;
+      }
+    }
+  };
+  const int t = std::max(1, std::min<int>(jobs, static_cast<int>(n)));
+  std::vector<std::thread> threads;
+  for (int k = 1; k < t; ++k) threads.emplace_back(worker);
+  worker();
+  for (auto& th : threads) th.join();
+  return first_error;
+}
+
+// Runs a stage over all sources with a progress bar fed from the frame counter.
+std::string run_stage(
+    const std::vector<FrameSource*>& sources, const CalibrateOptions& opt, const std::string& label,
+    const std::function<std::string(std::size_t, std::atomic<std::int64_t>*)>& job) {
+  std::int64_t total = 0;
+  for (auto* s : sources) total += static_cast<std::int64_t>(s->info().frame_count());
+  std::atomic<std::int64_t> done{0};
+  std::atomic<bool> finished{false};
+  std::string err;
+  std::thread runner([&] {
+    err =
+        for_each_recording(sources.size(), opt.jobs, [&](std::size_t i) { return job(i, &done); });
+    finished = true;
+  });
+  ProgressBar bar(label, total, opt.progress);
+  while (!finished.load()) {
+    bar.update(done.load());
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  runner.join();
+  if (err.empty()) bar.finish();
+  return err;
+}
+
+// ---- the least-squares model ------------------------------------------------------------------
+// est_r = diag(a) · k_m · Σ_c s_c · I_r[m][c]: integrated rotation of recording r under proxy m
+// with shear gains s, proxy gain factor k_m and per-axis rotation scales a, against θ_r.
+struct FitData {
+  Eigen::Vector3d theta = Eigen::Vector3d::Zero();
+  std::array<std::array<Eigen::Vector3d, kComponents>, kModes> I{};
+  double w = 1.0;
+  // Proxy whose per-frame rate follows the truth's rate best (scale-free), or -1 when the
+  // recording does not rotate enough to tell; such recordings go to the proxy with less drift.
+  int preferred = -1;
+};
+
+struct FitParams {
+  std::array<double, kComponents> s{0.0, 1.0, 1.0};
+  std::array<double, kModes> k{1.0, 1.0};
+  Eigen::Vector3d a = Eigen::Vector3d::Ones();
+  std::vector<int> mode;
+};
+
+Eigen::Vector3d combine(const FitData& d, const std::array<double, kComponents>& s, int m) {
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  for (int c = 0; c < kComponents; ++c)
+    v += s[static_cast<std::size_t>(c)] *
+         d.I[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)];
+  return v;
+}
+
+Eigen::Vector3d predict(const FitData& d, const FitParams& p, int m) {
+  return p.a.cwiseProduct(combine(d, p.s, m)) * p.k[static_cast<std::size_t>(m)];
+}
+
+double cost(const FitData& d, const FitParams& p, int m) {
+  return d.w * (predict(d, p, m) - d.theta).squaredNorm();
+}
+
+// min over s ≥ 0 of sᵀMs − 2bᵀs by enumerating the active sets (3 unknowns).
+std::array<double, 3> nnls3(const Eigen::Matrix3d& M, const Eigen::Vector3d& b,
+                            const std::array<double, 3>& fallback) {
+  double best = std::numeric_limits<double>::infinity();
+  std::array<double, 3> out = fallback;
+  for (int mask = 1; mask < 8; ++mask) {
+    std::vector<int> idx;
+    for (int i = 0; i < 3; ++i) {
+      if (mask & (1 << i)) idx.push_back(i);
+    }
+    const auto n = static_cast<Eigen::Index>(idx.size());
+    Eigen::MatrixXd Ms(n, n);
+    Eigen::VectorXd bs(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      bs(i) = b(idx[static_cast<std::size_t>(i)]);
+      for (Eigen::Index j = 0; j < n; ++j)
+        Ms(i, j) = M(idx[static_cast<std::size_t>(i)], idx[static_cast<std::size_t>(j)]);
+    }
+    const double tr = Ms.trace();
+    if (!(tr > 0.0)) continue;
+    Ms += 1e-12 * tr * Eigen::MatrixXd::Identity(n, n);
+    const Eigen::VectorXd x = Ms.ldlt().solve(bs);
+    if (!x.allFinite() || (x.array() < 0.0).any()) continue;
+    Eigen::Vector3d full = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = 0; i < n; ++i) full(idx[static_cast<std::size_t>(i)]) = x(i);
+    const double f = full.dot(M * full) - 2.0 * b.dot(full);
+    if (f < best) {
+      best = f;
+      out = {full(0), full(1), full(2)};
+    }
+  }
+  return out;
+}
+
+struct FitResult {
+  FitParams p;
+  int iterations = 0;
+  std::vector<std::string> notes;
+};
+
+FitResult fit_model(const std::vector<FitData>& data, const FitParams& start) {
+  FitResult res;
+  FitParams p = start;
+  const std::size_t n = data.size();
+  p.mode.assign(n, 0);
+  // Initial assignment: the proxy whose best single-gain fit explains the recording best
+  // (scale-free); recordings without a rotation worth the name: the proxy with less drift at the
+  // starting gains.
+  for (std::size_t r = 0; r < n; ++r) {
+    const FitData& d = data[r];
+    if (d.preferred >= 0) {
+      p.mode[r] = d.preferred;
+      continue;
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (int m = 0; m < kModes; ++m) {
+      const Eigen::Vector3d e = combine(d, p.s, m);
+      double c = 0.0;
+      if (d.theta.norm() >= kWeightFloorRad && e.squaredNorm() > 0.0) {
+        const double g = std::max(0.0, e.dot(d.theta) / e.squaredNorm());
+        c = (g * e - d.theta).squaredNorm() / d.theta.squaredNorm();
+      } else {
+        c = (e - d.theta).squaredNorm();
+      }
+      if (c < best) {
+        best = c;
+        p.mode[r] = m;
+      }
+    }
+  }
+  std::array<bool, 3> excited{false, false, false};
+  for (const auto& d : data) {
+    for (int ax = 0; ax < 3; ++ax)
+      excited[static_cast<std::size_t>(ax)] =
+          excited[static_cast<std::size_t>(ax)] || std::abs(d.theta(ax)) >= kWeightFloorRad;
+  }
+  for (int it = 0; it < 200; ++it) {
+    res.iterations = it + 1;
+    const FitParams before = p;
+    // (1) proxy gain factor per mode.
+    for (int m = 0; m < kModes; ++m) {
+      double num = 0.0, den = 0.0;
+      for (std::size_t r = 0; r < n; ++r) {
+        if (p.mode[r] != m) continue;
+        const Eigen::Vector3d e = p.a.cwiseProduct(combine(data[r], p.s, m));
+        num += data[r].w * e.dot(data[r].theta);
+        den += data[r].w * e.squaredNorm();
+      }
+      if (den > 0.0 && num > 0.0) p.k[static_cast<std::size_t>(m)] = num / den;
+    }
+    // (2) shear gains (non-negative), all recordings with their proxy.
+    {
+      Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d b = Eigen::Vector3d::Zero();
+      for (std::size_t r = 0; r < n; ++r) {
+        const int m = p.mode[r];
+        std::array<Eigen::Vector3d, 3> u;
+        for (int c = 0; c < kComponents; ++c) {
+          u[static_cast<std::size_t>(c)] =
+              p.k[static_cast<std::size_t>(m)] *
+              p.a.cwiseProduct(data[r].I[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)]);
+        }
+        for (int i = 0; i < 3; ++i) {
+          b(i) += data[r].w * u[static_cast<std::size_t>(i)].dot(data[r].theta);
+          for (int j = 0; j < 3; ++j)
+            M(i, j) +=
+                data[r].w * u[static_cast<std::size_t>(i)].dot(u[static_cast<std::size_t>(j)]);
+        }
+      }
+      const double ridge = kShearRidge * M.trace() / 3.0;
+      for (int i = 0; i < 3; ++i) {
+        M(i, i) += ridge;
+        b(i) += ridge * start.s[static_cast<std::size_t>(i)];
+      }
+      std::array<double, 3> s = nnls3(M, b, p.s);
+      const double mx = std::max({s[0], s[1], s[2]});
+      if (mx > 0.0) {
+        for (auto& v : s) v /= mx;
+        for (auto& k : p.k) k *= mx;
+        p.s = s;
+      }
+    }
+    // (3) per-axis rotation scales on the excited axes.
+    for (int ax = 0; ax < 3; ++ax) {
+      if (!excited[static_cast<std::size_t>(ax)]) continue;
+      double num = 0.0, den = 0.0;
+      for (std::size_t r = 0; r < n; ++r) {
+        const int m = p.mode[r];
+        const double e = p.k[static_cast<std::size_t>(m)] * combine(data[r], p.s, m)(ax);
+        num += data[r].w * e * data[r].theta(ax);
+        den += data[r].w * e * e;
+      }
+      if (den > 0.0 && num > 0.0) p.a(ax) = std::clamp(num / den, kJointScaleMin, kJointScaleMax);
+    }
+    // Scale freedom between a and k: geometric mean of the excited axes' scales = 1.
+    {
+      double lg = 0.0;
+      int cnt = 0;
+      for (int ax = 0; ax < 3; ++ax) {
+        if (excited[static_cast<std::size_t>(ax)]) {
+          lg += std::log(p.a(ax));
+          ++cnt;
+        }
+      }
+      if (cnt > 0) {
+        const double g = std::exp(lg / cnt);
+        for (int ax = 0; ax < 3; ++ax) {
+          if (excited[static_cast<std::size_t>(ax)]) p.a(ax) /= g;
+        }
+        for (auto& k : p.k) k *= g;
+      }
+    }
+    // (4) reassign every recording to the proxy that explains it best.
+    bool changed = false;
+    for (std::size_t r = 0; r < n && it < kFreezeAssignmentAfter; ++r) {
+      if (data[r].preferred >= 0) continue;
+      const int other = 1 - p.mode[r];
+      if (cost(data[r], p, other) < cost(data[r], p, p.mode[r])) {
+        p.mode[r] = other;
+        changed = true;
+      }
+    }
+    double delta = (p.a - before.a).cwiseAbs().maxCoeff();
+    for (int m = 0; m < kModes; ++m)
+      delta = std::max(delta, std::abs(std::log(p.k[static_cast<std::size_t>(m)] /
+                                                before.k[static_cast<std::size_t>(m)])));
+    for (int c = 0; c < kComponents; ++c)
+      delta = std::max(delta, std::abs(p.s[static_cast<std::size_t>(c)] -
+                                       before.s[static_cast<std::size_t>(c)]));
+    if (!changed && delta < 1e-9) break;
+  }
+  res.p = p;
+  return res;
+}
+
+// How much of the velocity-proxy rate persists once the object is at rest: the mean |ω̄| over the
+// frames after the truth's last motion (|ω_true| < 2 % of its peak), over the mean |ω̄| while
+// it moves. The velocity proxy reads shear as velocity: in the slide regime the shear relaxes
+// when the motion stops (ratio ≈ 0); while the contact sticks the shear is the displacement and
+// stays (ratio ≈ 1 or more). -1 if the recording has no rest after a motion.
+double rest_persistence(const std::vector<Eigen::Vector3d>& est,
+                        const std::vector<dsp::Vector6d>& truth) {
+  const std::size_t n = std::min(est.size(), truth.size());
+  double peak = 0.0;
+  for (std::size_t i = 0; i < n; ++i) peak = std::max(peak, truth[i].head<3>().norm());
+  if (!(peak > 0.0)) return -1.0;
+  std::size_t last_motion = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (truth[i].head<3>().norm() >= 0.02 * peak) last_motion = i;
+  }
+  double moving = 0.0, rest = 0.0;
+  std::size_t nm = 0, nr = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (truth[i].head<3>().norm() >= 0.02 * peak) {
+      moving += est[i].norm();
+      ++nm;
+    } else if (i > last_motion + 12) {  // skip the gel's relaxation (0.1 s at 120 Hz)
+      rest += est[i].norm();
+      ++nr;
+    }
+  }
+  if (nm == 0 || nr < 6 || !(moving > 0.0)) return -1.0;
+  return (rest / static_cast<double>(nr)) / (moving / static_cast<double>(nm));
+}
+
+std::string sim_regime(const std::string& json) {
+  const auto at = json.find("\"regime\"");
+  if (at == std::string::npos) return {};
+  const auto q1 = json.find('"', json.find(':', at) + 1);
+  if (q1 == std::string::npos) return {};
+  const auto q2 = json.find('"', q1 + 1);
+  if (q2 == std::string::npos) return {};
+  return json.substr(q1 + 1, q2 - q1 - 1);
+}
+
+double geodesic_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return rotation_error_deg(dsp::so3_exp(a), dsp::so3_exp(b));
+}
+
+std::string now_utc() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+double round_sig(double v, int digits) {
+  if (v == 0.0 || !std::isfinite(v)) return v;
+  const double e =
+      std::pow(10.0, digits - 1 - static_cast<int>(std::floor(std::log10(std::abs(v)))));
+  return std::round(v * e) / e;
+}
+
+}  // namespace
+
+std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateOptions& opt,
+                      CalibrateReport* report) {
+  if (sources.empty()) return "no recordings given";
+  for (auto* s : sources) {
+    if (!s->info().has_truth()) {
+      return s->info().name + ": has no truth.csv; calibration needs recordings with truth";
+    }
+  }
+  auto log = [&](const std::string& m) {
+    if (opt.log) opt.log(m);
+  };
+  CalibrateReport rep;
+  const std::size_t n = sources.size();
+  rep.recordings.resize(n);
+  std::vector<FitData> data(n);
+  std::vector<Eigen::Vector3d> truth_p(n);
+  for (std::size_t r = 0; r < n; ++r) {
+    const SourceInfo& in = sources[r]->info();
+    const dsp::Pose tp = truth_pose_at(in.truth, in.t_ns.back());
+    data[r].theta = dsp::so3_log(tp.q);
+    data[r].w = 1.0 / std::pow(std::max(data[r].theta.norm(), kWeightFloorRad), 2.0);
+    truth_p[r] = tp.p;
+    rep.recordings[r].name = in.name;
+    rep.recordings[r].truth_rotation_deg = data[r].theta * kDeg;
+    rep.recordings[r].truth_translation_mm = tp.p.norm() * 1e3;
+    rep.recordings[r].sim_regime = sim_regime(in.extra_json);
+  }
+  // The file's pixel pitch is the calibration rig's (the replay rescales the proxy gains for a
+  // rig with another pitch).
+  const double rig_pitch_m = sources[0]->info().pixel_pitch_mm * 1e-3;
+  for (auto* s : sources) {
+    if (std::abs(s->info().pixel_pitch_mm * 1e-3 - rig_pitch_m) > 1e-12) {
+      rep.notes.push_back("recordings have different pixel pitches; the file uses " +
+                          sources[0]->info().name + "'s");
+      break;
+    }
+  }
+  config::CalibrationSet base = opt.start;
+  for (auto& c : base.sensor) {
+    const double ratio = rig_pitch_m / c.pixel_pitch_m;
+    c.pixel_pitch_m = rig_pitch_m;
+    c.c_velocity *= ratio;
+    c.c_displacement *= ratio;
+  }
+
+  // ---- stage 0: starting calibration in both proxies; f^z noise for τ --------------------
+  log("stage 1/3: starting calibration, contact threshold from the f^z noise");
+  std::vector<FzHistogram> hists(n);
+  std::vector<std::vector<RunOutput>> out0(n);
+  std::string err = run_stage(sources, opt, "calibrate 1/3", [&](std::size_t r, auto* done) {
+    std::vector<ReplayOptions> cfg(2);
+    for (int m = 0; m < kModes; ++m) {
+      cfg[static_cast<std::size_t>(m)].calibration = base;
+      cfg[static_cast<std::size_t>(m)].mode = mode_of(m);
+    }
+    return run_pass(*sources[r], cfg, done, &hists[r], &out0[r], true);
+  });
+  if (!err.empty()) return err;
+  FzHistogram hist;
+  for (const auto& h : hists) hist.merge(h);
+  rep.fz_noise_sigma = hist.mad_sigma();
+  rep.fz_contact_p999 = hist.positive_quantile(0.999);
+  double tau_on = round_sig(6.0 * rep.fz_noise_sigma, 3);
+  const double tau_cap = 0.5 * rep.fz_contact_p999;
+  if (!(tau_on >= 0.005)) {
+    tau_on = 0.005;
+    rep.notes.push_back("contact_tau_on raised to its floor 0.005 (f^z noise below 1e-3)");
+  }
+  if (tau_cap > 0.0 && tau_on > tau_cap) {
+    tau_on = round_sig(tau_cap, 3);
+    rep.notes.push_back("contact_tau_on capped at half the 99.9th percentile of f^z (noisy f^z)");
+  }
+  const double tau_off = round_sig(std::min(tau_on, 3.0 * rep.fz_noise_sigma), 3);
+  for (auto& c : base.sensor) {
+    c.contact_tau_on = tau_on;
+    c.contact_tau_off = std::max(0.0, tau_off);
+  }
+
+  // ---- stage 1: one run per proxy and shear component -------------------------------------
+  log("stage 2/3: one run per proxy and shear component (d, r, k)");
+  std::vector<std::vector<RunOutput>> out1(n);
+  err = run_stage(sources, opt, "calibrate 2/3", [&](std::size_t r, auto* done) {
+    std::vector<ReplayOptions> cfg;
+    for (int m = 0; m < kModes; ++m) {
+      for (int c = 0; c < kComponents; ++c) {
+        ReplayOptions o;
+        o.calibration = base;
+        o.mode = mode_of(m);
+        for (auto& s : o.calibration.sensor) {
+          s.shear_gain_d = c == 0 ? 1.0 : 0.0;
+          s.shear_gain_r = c == 1 ? 1.0 : 0.0;
+          s.shear_gain_k = c == 2 ? 1.0 : 0.0;
+          s.rotation_scale = {1.0, 1.0, 1.0};
+        }
+        cfg.push_back(o);
+      }
+    }
+    return run_pass(*sources[r], cfg, done, nullptr, &out1[r]);
+  });
+  if (!err.empty()) return err;
+  for (std::size_t r = 0; r < n; ++r) {
+    for (int m = 0; m < kModes; ++m) {
+      for (int c = 0; c < kComponents; ++c) {
+        data[r].I[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)] =
+            out1[r][static_cast<std::size_t>(m * kComponents + c)].rot_integral;
+      }
+    }
+  }
+  // Which proxy explains each recording (label-free): a rotating recording by how much of the
+  // velocity-proxy rate persists at rest; a recording without rotation by the smaller combined
+  // rotation-drift and translation error of the two proxies at the starting gains.
+  for (std::size_t r = 0; r < n; ++r) {
+    const SourceInfo& in = sources[r]->info();
+    if (data[r].theta.norm() >= kWeightFloorRad) {
+      const auto tw = truth_twists(in.truth, in.t_ns);
+      const double persist = rest_persistence(out0[r][0].omega, tw);
+      rep.recordings[r].rest_persistence = persist;
+      if (persist >= 0.0) data[r].preferred = persist < kRestPersistenceMax ? 0 : 1;
+    }
+    if (data[r].preferred < 0) {
+      double best = std::numeric_limits<double>::infinity();
+      for (int m = 0; m < kModes; ++m) {
+        const dsp::Pose& e = out0[r][static_cast<std::size_t>(m)].final_pose;
+        const double rot = rotation_error_deg(e.q, dsp::so3_exp(data[r].theta)) / kDeg /
+                           std::max(data[r].theta.norm(), kWeightFloorRad);
+        const double tr = (e.p - truth_p[r]).norm() / std::max(truth_p[r].norm(), 1e-3);
+        const double c = rot * rot + tr * tr;
+        if (c < best) {
+          best = c;
+          data[r].preferred = m;
+        }
+      }
+    }
+    out0[r][0].omega.clear();
+    out0[r][1].omega.clear();
+  }
+  FitParams start;
+  {
+    const dsp::Calibration& c0 = base.sensor[0];
+    start.s = {c0.shear_gain_d, c0.shear_gain_r, c0.shear_gain_k};
+    const double mx = std::max({start.s[0], start.s[1], start.s[2]});
+    if (mx > 0.0) {
+      for (auto& v : start.s) v /= mx;
+    } else {
+      start.s = {0.0, 1.0, 1.0};
+    }
+  }
+  const FitResult fit = fit_model(data, start);
+  rep.iterations = fit.iterations;
+  rep.shear_gains = fit.p.s;
+  config::CalibrationSet fitted = base;
+  for (int m = 0; m < kModes; ++m) {
+    rep.recordings_per_mode[static_cast<std::size_t>(m)] =
+        static_cast<int>(std::count(fit.p.mode.begin(), fit.p.mode.end(), m));
+  }
+  for (auto& c : fitted.sensor) {
+    c.shear_gain_d = round_sig(fit.p.s[0], 4);
+    c.shear_gain_r = round_sig(fit.p.s[1], 4);
+    c.shear_gain_k = round_sig(fit.p.s[2], 4);
+    for (int m = 0; m < kModes; ++m) {
+      double& gain = m == 0 ? c.c_velocity : c.c_displacement;
+      const double hi = m == 0 ? 100.0 : 1.0;
+      if (rep.recordings_per_mode[static_cast<std::size_t>(m)] == 0) {
+        rep.notes.push_back(std::string("no recording is explained by the ") +
+                            to_string(mode_of(m)) + " proxy: its gain is kept at the start value");
+        continue;
+      }
+      const double k = std::clamp(fit.p.k[static_cast<std::size_t>(m)], 0.02, 50.0);
+      if (k != fit.p.k[static_cast<std::size_t>(m)]) {
+        rep.notes.push_back(std::string("the ") + to_string(mode_of(m)) +
+                            " proxy gain hit its sanity bound (x0.02 .. x50 of the start value)");
+      }
+      gain = round_sig(std::clamp(gain * k, 1e-9, hi), 4);
+    }
+    for (int ax = 0; ax < 3; ++ax)
+      c.rotation_scale[static_cast<std::size_t>(ax)] = round_sig(fit.p.a(ax), 4);
+  }
+  for (std::size_t r = 0; r < n; ++r) {
+    rep.recordings[r].explained_by = mode_of(fit.p.mode[r]);
+    rep.recordings[r].before_deg = rotation_error_deg(
+        out0[r][static_cast<std::size_t>(fit.p.mode[r])].final_pose.q, dsp::so3_exp(data[r].theta));
+  }
+  // The slip detector's thresholds are fitted here once dsp::VelocityProxy::kAuto exists: run
+  // kAuto with the gains above and choose the thresholds that minimise the same integrated-
+  // rotation cost, with each frame's proxy chosen by the detector (docs/calibration.md).
+  rep.notes.push_back(
+      "slip detector thresholds: not fitted (the pipeline has no VelocityProxy::kAuto yet)");
+
+  // ---- stage 2: validation runs; paper-fusion and translation scales -----------------------
+  log("stage 3/3: validation runs (joint, paper) with the fitted gains");
+  std::vector<std::vector<RunOutput>> out2(n);
+  err = run_stage(sources, opt, "calibrate 3/3", [&](std::size_t r, auto* done) {
+    std::vector<ReplayOptions> cfg;
+    for (auto method : {dsp::FusionMethod::kJoint, dsp::FusionMethod::kPaper}) {
+      for (int m = 0; m < kModes; ++m) {
+        ReplayOptions o;
+        o.calibration = fitted;
+        o.method = method;
+        o.mode = mode_of(m);
+        for (auto& p : o.calibration.paper) p = config::PaperScales{};
+        cfg.push_back(o);
+      }
+    }
+    return run_pass(*sources[r], cfg, done, nullptr, &out2[r]);
+  });
+  if (!err.empty()) return err;
+  auto run_of = [&](std::size_t r, bool paper) -> const RunOutput& {
+    return out2[r][static_cast<std::size_t>((paper ? 2 : 0) + fit.p.mode[r])];
+  };
+  // Paper fusion: per-axis rotation scales (ω_x, ω_y are lever-scaled there).
+  Eigen::Vector3d ap = Eigen::Vector3d::Ones();
+  for (int ax = 0; ax < 3; ++ax) {
+    double num = 0.0, den = 0.0, excite = 0.0;
+    for (std::size_t r = 0; r < n; ++r) {
+      const double e = run_of(r, true).rot_integral(ax);
+      num += data[r].w * e * data[r].theta(ax);
+      den += data[r].w * e * e;
+      excite = std::max(excite, std::abs(data[r].theta(ax)));
+    }
+    if (excite >= kWeightFloorRad && den > 0.0 && num > 0.0) {
+      ap(ax) = round_sig(std::clamp(num / den, 1e-3, 100.0), 4);
+    } else {
+      rep.notes.push_back(std::string("paper fusion: no rotation about ") + "xyz"[ax] +
+                          " in the recordings; its scale stays 1");
+    }
+  }
+  // Translation scales (x, y; t_z = 0) from recordings that translate.
+  auto fit_translation = [&](bool paper, const char* what) {
+    std::array<double, 3> st{1.0, 1.0, 1.0};
+    for (int ax = 0; ax < 2; ++ax) {
+      double num = 0.0, den = 0.0;
+      for (std::size_t r = 0; r < n; ++r) {
+        if (std::abs(truth_p[r](ax)) < 1e-3) continue;
+        // The proxy whose translation is closer to the truth (the two proxies measure
+        // translation differently: contact centroid vs common material points).
+        const std::size_t base_idx = paper ? 2 : 0;
+        const RunOutput& ra = out2[r][base_idx];
+        const RunOutput& rb = out2[r][base_idx + 1];
+        const bool use_b =
+            (rb.final_pose.p - truth_p[r]).norm() < (ra.final_pose.p - truth_p[r]).norm();
+        const double e = (use_b ? rb : ra).final_pose.p(ax);
+        num += e * truth_p[r](ax);
+        den += e * e;
+      }
+      if (den > 0.0 && num > 0.0) {
+        const double v = num / den;
+        st[static_cast<std::size_t>(ax)] = round_sig(std::clamp(v, 0.2, 5.0), 4);
+        if (st[static_cast<std::size_t>(ax)] != round_sig(v, 4)) {
+          rep.notes.push_back(std::string(what) + " translation scale " + "xy"[ax] +
+                              " hit its sanity bound 0.2 .. 5");
+        }
+      } else {
+        rep.notes.push_back(std::string(what) + ": no translation along " + "xy"[ax] +
+                            " in the recordings; its translation scale stays 1");
+      }
+    }
+    return st;
+  };
+  const auto st_joint = fit_translation(false, "joint fusion");
+  const auto st_paper = fit_translation(true, "paper fusion");
+  for (std::size_t k = 0; k < 2; ++k) {
+    fitted.sensor[k].translation_scale = st_joint;
+    fitted.paper[k].rotation_scale = {ap(0), ap(1), ap(2)};
+    fitted.paper[k].translation_scale = st_paper;
+  }
+  for (std::size_t r = 0; r < n; ++r) {
+    RecordingFit& f = rep.recordings[r];
+    const dsp::Pose tp{dsp::so3_exp(data[r].theta), truth_p[r]};
+    f.after_deg = rotation_error_deg(run_of(r, false).final_pose.q, tp.q);
+    f.after_other_deg =
+        rotation_error_deg(out2[r][static_cast<std::size_t>(1 - fit.p.mode[r])].final_pose.q, tp.q);
+    f.after_paper_deg = geodesic_deg(ap.cwiseProduct(run_of(r, true).rot_integral), data[r].theta);
+    const Eigen::Vector3d pe = run_of(r, false).final_pose.p.cwiseProduct(
+        Eigen::Vector3d(st_joint[0], st_joint[1], st_joint[2]));
+    f.translation_after_mm = (pe - truth_p[r]).norm() * 1e3;
+  }
+
+  fitted.meta.generator = "tacse3-calibrate";
+  fitted.meta.created = now_utc();
+  fitted.meta.recordings.clear();
+  for (auto* s : sources) fitted.meta.recordings.push_back(s->info().name);
+  fitted.meta.note = "fitted from " + std::to_string(n) + " recording(s); see docs/calibration.md";
+  if (config::Status s = config::validate(fitted, "fitted calibration"); !s) {
+    return "internal error: " + s.message();
+  }
+  rep.calibration = fitted;
+  *report = std::move(rep);
+  return {};
+}
+
+std::string format_report(const CalibrateReport& rep) {
+  std::string o;
+  char line[512];
+  const dsp::Calibration& c = rep.calibration.sensor[0];
+  std::snprintf(line, sizeof(line),
+                "contact threshold: f^z noise sigma %.4g -> contact_tau_on %.4g, contact_tau_off "
+                "%.4g\n",
+                rep.fz_noise_sigma, c.contact_tau_on, c.contact_tau_off);
+  o += line;
+  std::snprintf(line, sizeof(line),
+                "shear gains (d, r, k) = (%.4g, %.4g, %.4g); c_velocity %.4g m/s per unit "
+                "(%d recording(s)), c_displacement %.4g m per unit (%d recording(s)); %d "
+                "iteration(s)\n",
+                c.shear_gain_d, c.shear_gain_r, c.shear_gain_k, c.c_velocity,
+                rep.recordings_per_mode[0], c.c_displacement, rep.recordings_per_mode[1],
+                rep.iterations);
+  o += line;
+  const auto& p = rep.calibration.paper[0];
+  std::snprintf(line, sizeof(line),
+                "rotation scales: joint (%.4g, %.4g, %.4g), paper (%.4g, %.4g, %.4g); "
+                "translation scales: joint (%.4g, %.4g), paper (%.4g, %.4g)\n",
+                c.rotation_scale[0], c.rotation_scale[1], c.rotation_scale[2], p.rotation_scale[0],
+                p.rotation_scale[1], p.rotation_scale[2], c.translation_scale[0],
+                c.translation_scale[1], p.translation_scale[0], p.translation_scale[1]);
+  o += line;
+  o += "fit quality (final rotation error, deg; joint fusion measured, paper predicted):\n";
+  std::snprintf(line, sizeof(line), "  %-32s %7s %6s %7s %-12s %7s %7s %7s %7s %8s\n", "recording",
+                "truth", "sim", "persist", "explained by", "before", "after", "other", "paper",
+                "trans mm");
+  o += line;
+  for (const auto& r : rep.recordings) {
+    std::string name = r.name;
+    if (name.size() > 32) name = "..." + name.substr(name.size() - 29);
+    char persist[16] = "-";
+    if (r.rest_persistence >= 0.0)
+      std::snprintf(persist, sizeof(persist), "%.2f", r.rest_persistence);
+    std::snprintf(line, sizeof(line), "  %-32s %7.2f %6s %7s %-12s %7.2f %7.2f %7.2f %7.2f %8.2f\n",
+                  name.c_str(), r.truth_rotation_deg.norm(),
+                  r.sim_regime.empty() ? "-" : r.sim_regime.c_str(), persist,
+                  to_string(r.explained_by), r.before_deg, r.after_deg, r.after_other_deg,
+                  r.after_paper_deg, r.translation_after_mm);
+    o += line;
+  }
+  for (const auto& n : rep.notes) o += "note: " + n + "\n";
+  return o;
+}
+
+}  // namespace tacse3::tools

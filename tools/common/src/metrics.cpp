@@ -1,0 +1,110 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tools: truth interpolation/differentiation and error metrics.
+#include "tacse3/tools/metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace tacse3::tools {
+
+namespace rec = tacse3::recording;
+
+namespace {
+constexpr double kDeg = 180.0 / std::numbers::pi;
+}
+
+dsp::Pose to_pose(const rec::TruthSample& s) noexcept {
+  dsp::Pose p;
+  p.q = Eigen::Quaterniond(s.qw, s.qx, s.qy, s.qz).normalized();
+  p.p = Eigen::Vector3d(s.px, s.py, s.pz);
+  return p;
+}
+
+dsp::Pose truth_pose_at(const std::vector<rec::TruthSample>& truth, std::int64_t t_ns) {
+  if (truth.empty()) return dsp::Pose{};
+  if (t_ns <= truth.front().t_ns) return to_pose(truth.front());
+  if (t_ns >= truth.back().t_ns) return to_pose(truth.back());
+  const auto it =
+      std::lower_bound(truth.begin(), truth.end(), t_ns,
+                       [](const rec::TruthSample& s, std::int64_t t) { return s.t_ns < t; });
+  if (it->t_ns == t_ns) return to_pose(*it);
+  const rec::TruthSample& b = *it;
+  const rec::TruthSample& a = *(it - 1);
+  const double u = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
+  const dsp::Pose pa = to_pose(a), pb = to_pose(b);
+  dsp::Pose p;
+  p.q = pa.q.slerp(u, pb.q).normalized();
+  p.p = (1.0 - u) * pa.p + u * pb.p;
+  return p;
+}
+
+std::vector<dsp::Vector6d> truth_twists(const std::vector<rec::TruthSample>& truth,
+                                        const std::vector<std::int64_t>& t_ns) {
+  std::vector<dsp::Vector6d> out(t_ns.size(), dsp::Vector6d::Zero());
+  if (truth.empty() || t_ns.size() < 2) return out;
+  std::vector<dsp::Pose> poses(t_ns.size());
+  for (std::size_t i = 0; i < t_ns.size(); ++i) poses[i] = truth_pose_at(truth, t_ns[i]);
+  for (std::size_t i = 0; i < t_ns.size(); ++i) {
+    const std::size_t a = i == 0 ? 0 : i - 1;
+    const std::size_t b = i + 1 < t_ns.size() ? i + 1 : i;
+    if (a == b) continue;
+    const double dt = static_cast<double>(t_ns[b] - t_ns[a]) * 1e-9;
+    if (!(dt > 0.0)) continue;
+    // T(b) = exp(ξ̂ dt) T(a)  ⇒  ξ = log(T(b) T(a)⁻¹) / dt  (spatial twist in G).
+    const dsp::Pose rel = dsp::compose(poses[b], dsp::inverse(poses[a]));
+    out[i] = dsp::se3_log(rel) / dt;
+  }
+  return out;
+}
+
+double rotation_error_deg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) noexcept {
+  const double d = std::clamp(std::abs(a.normalized().dot(b.normalized())), 0.0, 1.0);
+  return 2.0 * std::acos(d) * kDeg;
+}
+
+double rotation_angle_deg(const Eigen::Quaterniond& q) noexcept {
+  return rotation_error_deg(q, Eigen::Quaterniond::Identity());
+}
+
+PoseErrors pose_errors(const std::vector<dsp::Pose>& estimate,
+                       const std::vector<rec::TruthSample>& truth,
+                       const std::vector<std::int64_t>& t_ns) {
+  PoseErrors e;
+  const std::size_t n = std::min(estimate.size(), t_ns.size());
+  if (n == 0 || truth.empty()) return e;
+  for (std::size_t i = 0; i < n; ++i) {
+    const dsp::Pose t = truth_pose_at(truth, t_ns[i]);
+    const double r = rotation_error_deg(estimate[i].q, t.q);
+    const double p = (estimate[i].p - t.p).norm() * 1e3;
+    e.max_rotation_error_deg = std::max(e.max_rotation_error_deg, r);
+    e.max_translation_error_mm = std::max(e.max_translation_error_mm, p);
+    if (i + 1 == n) {
+      e.final_rotation_error_deg = r;
+      e.final_translation_error_mm = p;
+      e.true_rotation_deg = rotation_angle_deg(t.q);
+      e.estimated_rotation_deg = rotation_angle_deg(estimate[i].q);
+      e.true_translation_mm = t.p.norm() * 1e3;
+      e.estimated_translation_mm = estimate[i].p.norm() * 1e3;
+      e.final_rotation_vector_deg = dsp::so3_log(estimate[i].q) * kDeg;
+      e.true_rotation_vector_deg = dsp::so3_log(t.q) * kDeg;
+    }
+  }
+  return e;
+}
+
+void SlipScore::add(bool detected, bool label) noexcept {
+  if (detected && label) ++true_slip;
+  if (!detected && !label) ++true_stick;
+  if (detected && !label) ++false_slip;
+  if (!detected && label) ++false_stick;
+}
+
+void SlipScore::merge(const SlipScore& o) noexcept {
+  true_slip += o.true_slip;
+  true_stick += o.true_stick;
+  false_slip += o.false_slip;
+  false_stick += o.false_stick;
+}
+
+}  // namespace tacse3::tools

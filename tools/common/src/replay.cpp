@@ -1,0 +1,309 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tools: the replay engine: a recording through dsp::DualPipeline, row by row.
+#include "tacse3/tools/replay.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "tacse3/tools/can_log.hpp"
+#include "tacse3/tools/field_dump.hpp"
+#include "tacse3/tools/progress.hpp"
+
+namespace tacse3::tools {
+
+bool parse_mode(std::string_view s, ProxyMode* out) noexcept {
+  if (s == "auto") {
+    *out = ProxyMode::kAuto;
+  } else if (s == "velocity") {
+    *out = ProxyMode::kVelocity;
+  } else if (s == "displacement") {
+    *out = ProxyMode::kDisplacement;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool parse_method(std::string_view s, dsp::FusionMethod* out) noexcept {
+  if (s == "joint") {
+    *out = dsp::FusionMethod::kJoint;
+  } else if (s == "paper") {
+    *out = dsp::FusionMethod::kPaper;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool parse_sensors(std::string_view s, SensorChoice* out) noexcept {
+  if (s == "both") {
+    *out = SensorChoice::kBoth;
+  } else if (s == "left") {
+    *out = SensorChoice::kLeft;
+  } else if (s == "right") {
+    *out = SensorChoice::kRight;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* to_string(ProxyMode m) noexcept {
+  switch (m) {
+    case ProxyMode::kAuto:
+      return "auto";
+    case ProxyMode::kVelocity:
+      return "velocity";
+    case ProxyMode::kDisplacement:
+      return "displacement";
+  }
+  return "?";
+}
+
+const char* method_name(dsp::FusionMethod m) noexcept {
+  return m == dsp::FusionMethod::kPaper ? "paper" : "joint";
+}
+
+const char* to_string(SensorChoice s) noexcept {
+  switch (s) {
+    case SensorChoice::kBoth:
+      return "both";
+    case SensorChoice::kLeft:
+      return "left";
+    case SensorChoice::kRight:
+      return "right";
+  }
+  return "?";
+}
+
+// ---- the places that change when dsp::VelocityProxy::kAuto lands ---------------------------
+// (see docs/replay.md, "--mode auto"):
+//   pipeline_proxy:   ProxyMode::kAuto -> dsp::VelocityProxy::kAuto
+//   pipeline_has_auto: true
+//   detected_slip:    return r.slipping (the per-frame SensorResult flag)
+dsp::VelocityProxy pipeline_proxy(ProxyMode m) noexcept {
+  switch (m) {
+    case ProxyMode::kDisplacement:
+      return dsp::VelocityProxy::kDisplacement;
+    case ProxyMode::kVelocity:
+      return dsp::VelocityProxy::kVelocity;
+    case ProxyMode::kAuto:
+      // Until the pipeline has its own per-frame stick/slip switch, auto runs the sliding-regime
+      // proxy of the paper (dsp's default).
+      return dsp::VelocityProxy::kVelocity;
+  }
+  return dsp::VelocityProxy::kVelocity;
+}
+
+bool pipeline_has_auto() noexcept {
+  return false;
+}
+
+std::optional<bool> detected_slip(const dsp::SensorResult& r) noexcept {
+  (void)r;
+  return std::nullopt;
+}
+// ---------------------------------------------------------------------------------------------
+
+std::string make_setup(const SourceInfo& info, const ReplayOptions& options, EngineSetup* out) {
+  EngineSetup s;
+  const char* names[2] = {"left", "right"};
+  switch (options.sensors) {
+    case SensorChoice::kBoth:
+      s.use = info.has_sensor;
+      break;
+    case SensorChoice::kLeft:
+    case SensorChoice::kRight: {
+      const std::size_t k = options.sensors == SensorChoice::kLeft ? 0 : 1;
+      if (!info.has_sensor[k]) {
+        return info.name + "/recording.json: --sensors " + names[k] +
+               ", but the recording has no " + names[k] + " sensor";
+      }
+      s.use[k] = true;
+      break;
+    }
+  }
+  if (!s.use[0] && !s.use[1]) return info.name + "/recording.json: no sensor to replay";
+
+  s.cal = options.calibration.for_method(options.method);
+  const double pitch_m = info.pixel_pitch_mm * 1e-3;
+  for (std::size_t k = 0; k < 2; ++k) {
+    dsp::Calibration& c = s.cal[k];
+    // The rig's pixel pitch replaces the calibration's. The proxy gains are metres (per second)
+    // per pixel of shear, so they scale with the pitch: a file calibrated at one pitch stays
+    // right on a rig with another.
+    const double ratio = pitch_m / c.pixel_pitch_m;
+    c.pixel_pitch_m = pitch_m;
+    c.c_velocity *= ratio;
+    c.c_displacement *= ratio;
+    c.velocity_proxy = pipeline_proxy(options.mode);
+    if (dsp::validate(c) != dsp::Status::kOk) {
+      return info.name + "/recording.json: rig.pixel_pitch_mm " +
+             std::to_string(info.pixel_pitch_mm) + " makes the " + names[k] +
+             " calibration invalid (pixel pitch must be 0.001 .. 0.2 mm and the rescaled proxy "
+             "gains within their ranges)";
+    }
+  }
+  s.dual.fusion.method = options.method;
+  s.dual.finger_separation_m = info.finger_separation_mm * 1e-3;
+  if (!(s.dual.finger_separation_m >= 0.0 && s.dual.finger_separation_m <= 0.5)) {
+    return info.name + "/recording.json: rig.finger_separation_mm " +
+           std::to_string(info.finger_separation_mm) + " is outside 0 .. 500 mm";
+  }
+  // Nominal period: the median frame step (used for the first frame only).
+  if (info.t_ns.size() >= 2) {
+    std::vector<std::int64_t> d;
+    d.reserve(info.t_ns.size() - 1);
+    for (std::size_t i = 1; i < info.t_ns.size(); ++i) d.push_back(info.t_ns[i] - info.t_ns[i - 1]);
+    std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+    const double p = static_cast<double>(d[d.size() / 2]) * 1e-9;
+    if (p >= 1e-4 && p <= 1.0) s.dual.nominal_frame_period_s = p;
+    // A recording at a lower rate must not be treated as a stream of gaps.
+    s.dual.max_frame_gap_s = std::clamp(std::max(s.dual.max_frame_gap_s, 4.0 * p), 1e-4, 1.0);
+  }
+  if (dsp::validate(s.dual) != dsp::Status::kOk) {
+    return info.name + ": the dual-pipeline configuration is invalid";
+  }
+  *out = s;
+  return {};
+}
+
+Replayer::Replayer() : pipeline_(std::make_unique<dsp::DualPipeline>()) {}
+Replayer::~Replayer() = default;
+
+std::string Replayer::init(const SourceInfo& info, const ReplayOptions& options) {
+  name_ = info.name;
+  if (std::string e = make_setup(info, options, &setup_); !e.empty()) return e;
+  const dsp::Status st = pipeline_->configure(setup_.dual, setup_.cal);
+  if (st != dsp::Status::kOk) {
+    return info.name + ": the pipeline rejected the configuration: " + dsp::to_string(st);
+  }
+  return {};
+}
+
+std::string Replayer::step(FrameSource& source, std::size_t index, FrameResult* out) {
+  std::array<const dsp::FrameView*, 2> views{};
+  if (std::string e = source.read(index, &views); !e.empty()) return e;
+  return step_views(views, source.info().t_ns[index], index, out);
+}
+
+std::string Replayer::step_views(std::array<const dsp::FrameView*, 2> views, std::int64_t t,
+                                 std::size_t index, FrameResult* out) {
+  for (std::size_t k = 0; k < 2; ++k) {
+    if (!setup_.use[k]) views[k] = nullptr;
+  }
+  pipeline_->process(views[0], views[1], t, result_);
+  const char* names[2] = {"left", "right"};
+  for (std::size_t k = 0; k < 2; ++k) {
+    const dsp::Status s = result_.sensors[k].status;
+    if (views[k] != nullptr && s != dsp::Status::kOk) {
+      return name_ + ": frame " + std::to_string(index) + " (" + names[k] +
+             "): rejected by the pipeline: " + dsp::to_string(s);
+    }
+  }
+  FrameResult& r = *out;
+  r = FrameResult{};
+  r.t_ns = t;
+  r.twist = result_.twist;
+  r.pose = result_.pose;
+  r.estimate_valid = result_.valid;
+  r.single_sensor = result_.single_sensor;
+  r.confidence = result_.fused.confidence;
+  r.dt_s = result_.dt_s;
+  const std::uint8_t used = result_.fused.rotation_sensors | result_.fused.translation_sensors;
+  for (std::size_t k = 0; k < 2; ++k) {
+    const dsp::SensorResult& sr = result_.sensors[k];
+    r.present[k] = views[k] != nullptr;
+    r.valid[k] = (used & (k == 0 ? dsp::kSensor1 : dsp::kSensor2)) != 0;
+    r.contact[k] = sr.processed && sr.motion.contact;
+    if (r.present[k]) r.slipping[k] = detected_slip(sr);
+  }
+  return {};
+}
+
+void write_csv_row(std::FILE* f, const FrameResult& r) {
+  const auto& w = r.twist;
+  std::fprintf(f,
+               "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.12f,%.12f,%.12f,%.12f,%.9g,%.9g,%.9g,%d,%d\n",
+               static_cast<long long>(r.t_ns), w[0], w[1], w[2], w[3], w[4], w[5], r.pose.q.w(),
+               r.pose.q.x(), r.pose.q.y(), r.pose.q.z(), r.pose.p.x(), r.pose.p.y(), r.pose.p.z(),
+               r.valid[0] ? 1 : 0, r.valid[1] ? 1 : 0);
+}
+
+ReplayRun run_replay(FrameSource& source, const ReplayOptions& options, const ReplaySinks& sinks) {
+  ReplayRun run;
+  Replayer engine;
+  if (std::string e = engine.init(source.info(), options); !e.empty()) {
+    run.error = e;
+    return run;
+  }
+  const std::size_t n = source.info().frame_count();
+  run.frames.reserve(n);
+  if (sinks.csv != nullptr) std::fprintf(sinks.csv, "%s\n", kCsvHeader);
+  for (std::size_t i = 0; i < n; ++i) {
+    FrameResult r;
+    if (std::string e = engine.step(source, i, &r); !e.empty()) {
+      run.error = e;
+      return run;
+    }
+    if (sinks.csv != nullptr) write_csv_row(sinks.csv, r);
+    if (sinks.dump != nullptr) {
+      std::array<const dsp::SensorFields*, 2> f{nullptr, nullptr};
+      for (std::size_t k = 0; k < 2; ++k) {
+        if (r.present[k])
+          f[k] = &engine.pipeline().sensor(static_cast<dsp::SensorSlot>(k)).fields();
+      }
+      if (std::string e = sinks.dump->append(r.t_ns, f); !e.empty()) {
+        run.error = e;
+        return run;
+      }
+    }
+    if (sinks.can != nullptr) {
+      if (std::string e = sinks.can->append(r); !e.empty()) {
+        run.error = e;
+        return run;
+      }
+    }
+    if (sinks.on_frame) sinks.on_frame(i, r, engine);
+    run.frames.push_back(r);
+    if (sinks.progress != nullptr) sinks.progress->update(static_cast<std::int64_t>(i + 1));
+  }
+  return run;
+}
+
+RunSummary summarize(const SourceInfo& info, const std::vector<FrameResult>& frames,
+                     SensorChoice sensors) {
+  RunSummary s;
+  if (frames.empty()) return s;
+  std::int64_t valid = 0;
+  for (const auto& f : frames) valid += f.estimate_valid ? 1 : 0;
+  s.valid_fraction = static_cast<double>(valid) / static_cast<double>(frames.size());
+  if (info.has_truth()) {
+    s.has_truth = true;
+    std::vector<dsp::Pose> poses;
+    std::vector<std::int64_t> t;
+    poses.reserve(frames.size());
+    for (const auto& f : frames) {
+      poses.push_back(f.pose);
+      t.push_back(f.t_ns);
+    }
+    s.errors = pose_errors(poses, info.truth, t);
+  }
+  if (!info.labels.empty()) {
+    for (const auto& l : info.labels) {
+      const std::size_t k = static_cast<std::size_t>(l.sensor);
+      if (sensors == SensorChoice::kLeft && k != 0) continue;
+      if (sensors == SensorChoice::kRight && k != 1) continue;
+      if (l.index < 0 || static_cast<std::size_t>(l.index) >= frames.size() || !l.in_contact) {
+        continue;
+      }
+      const auto& det = frames[static_cast<std::size_t>(l.index)].slipping[k];
+      if (!det.has_value()) continue;
+      s.has_slip_score = true;
+      s.slip.add(*det, l.slipping);
+    }
+  }
+  return s;
+}
+
+}  // namespace tacse3::tools
