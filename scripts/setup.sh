@@ -20,6 +20,8 @@ PACKAGES=(
   libtomlplusplus-dev libcli11-dev libspng-dev libpng-dev nlohmann-json3-dev
   # hardware backends: MJPEG decode, GPIO, libcamera
   libturbojpeg0-dev libgpiod-dev libcamera-dev
+  # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks
+  libsystemd-dev dpkg-dev file
   # fuzzing (libFuzzer and sanitizer runtimes for clang)
   libclang-rt-14-dev
   # protocol cross-checks: python-can example and the independent DBC decoder (npm)
