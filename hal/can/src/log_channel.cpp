@@ -64,9 +64,19 @@ LogChannel::~LogChannel() {
   if (own_out_ && out_ != nullptr) std::fclose(out_);
 }
 
+ChannelStats LogChannel::stats() const {
+  ChannelStats s;
+  s.tx_frames = tx_frames_.load(std::memory_order_relaxed);
+  s.tx_errors = tx_errors_.load(std::memory_order_relaxed);
+  s.rx_frames = rx_frames_.load(std::memory_order_relaxed);
+  s.error_frames = error_frames_.load(std::memory_order_relaxed);
+  return s;
+}
+
 bool LogChannel::send(const CanFrame& f) {
   if (out_ == nullptr) {
     error_ = "log channel has no output";
+    tx_errors_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
   protocol::LogRecord r;
@@ -77,13 +87,16 @@ bool LogChannel::send(const CanFrame& f) {
   const std::size_t n = protocol::format_candump_line(r, line, sizeof line - 1);
   if (n == 0) {
     error_ = "frame cannot be written as a candump line";
+    tx_errors_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
   line[n] = '\n';
   if (std::fwrite(line, 1, n + 1, out_) != n + 1 || std::fflush(out_) != 0) {
     error_ = std::string("writing the log failed: ") + std::strerror(errno);
+    tx_errors_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
+  tx_frames_.fetch_add(1, std::memory_order_relaxed);
   return true;
 }
 
@@ -110,11 +123,13 @@ RxResult LogChannel::receive(RxFrame& out, int /*timeout_ms*/) {
       continue;
     }
     if (r.rtr || r.error_frame) {
+      if (r.error_frame) error_frames_.fetch_add(1, std::memory_order_relaxed);
       ++skipped_;
       continue;
     }
     out.frame = r.frame;
     out.time_us = r.time_us;
+    rx_frames_.fetch_add(1, std::memory_order_relaxed);
     return RxResult::kFrame;
   }
   if (std::ferror(in_) != 0) {

@@ -2,6 +2,7 @@
 // tacse3 hal/can: the candump -L log backend (read frames from a log, write frames as a log).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
@@ -28,6 +29,10 @@ class LogChannel final : public Channel {
   bool send(const CanFrame& f) override;
   RxResult receive(RxFrame& out, int timeout_ms) override;
   const std::string& last_error() const override { return error_; }
+  // tx_frames: lines written; tx_errors: frames refused or write failures; rx_frames: data
+  // frames read; error_frames: error frames in the input log. No queue, the bus is always
+  // error-active and nothing is ever dropped by policy.
+  ChannelStats stats() const override;
 
   // Time stamp written for sent frames; defaults to CLOCK_REALTIME (as candump does).
   void set_clock(std::function<std::uint64_t()> now_us) { now_us_ = std::move(now_us); }
@@ -47,6 +52,7 @@ class LogChannel final : public Channel {
   std::uint64_t lines_ = 0;
   std::uint64_t bad_lines_ = 0;
   std::uint64_t skipped_ = 0;
+  std::atomic<std::uint64_t> tx_frames_{0}, tx_errors_{0}, rx_frames_{0}, error_frames_{0};
 };
 
 }  // namespace tacse3::hal::can
