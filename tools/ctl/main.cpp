@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // tacse3 ctl: tacse3-ctl, sends a command frame to a gripper and waits for its ACK/NACK.
+#include <linux/can.h>
 #include <time.h>
 
 #include <CLI/CLI.hpp>
@@ -194,11 +195,14 @@ int main(int argc, char** argv) {
   if (!iface.empty()) {
     can::SocketCanOptions so;
     so.fd = fd;
-    // Only this node's Ack identifier.
+    // Only this node's Ack identifier, as a data frame: the mask includes the EFF and RTR flags,
+    // so the kernel passes neither the other id length nor remote frames.
     const std::uint32_t ack_id =
         tp::compose_id(tx.endpoint.layout, tx.endpoint.node_id, tp::MessageId::kAck);
-    so.filters.push_back(extended ? can::SocketCanFilter{ack_id | 0x80000000u, 0x9FFFFFFFu}
-                                  : can::SocketCanFilter{ack_id, 0x800007FFu});
+    so.filters.push_back(
+        extended ? can::SocketCanFilter{ack_id | CAN_EFF_FLAG,
+                                        CAN_EFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG}
+                 : can::SocketCanFilter{ack_id, CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG});
     auto s = can::SocketCanChannel::open(iface, so, error);
     if (!s) {
       std::cerr << "tacse3-ctl: " << error << '\n';
