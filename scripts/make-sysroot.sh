@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# tacse3: unpack the target's HAL libraries (libgpiod, libturbojpeg, libcamera) into build/sysroot/<arch>.
+# tacse3: unpack the target's libraries (gpiod, turbojpeg, libcamera, spng, systemd) into build/sysroot/<arch>.
 #
 # Usage: scripts/make-sysroot.sh <aarch64|arm64|armhf> [--no-libcamera]
 #
 # The cross presets compile against Debian's cross toolchain (/usr/<triple>), which has libc and
 # libstdc++ but not the HAL libraries. Installing them with multiarch (apt-get install pkg:arm64)
 # upgrades host packages in lockstep and breaks on partial mirrors, so this script only downloads
-# the target .debs (apt-get download) and unpacks them with dpkg -x into a private sysroot. The hal
-# CMake looks there through TACSE3_TARGET_SYSROOT (default: build/sysroot/<arch>).
+# the target .debs (apt-get download) and unpacks them with dpkg -x into a private sysroot.
+# cmake/Tacse3TargetDeps.cmake looks there through TACSE3_TARGET_SYSROOT (default:
+# build/sysroot/<arch>). The new sysroot is assembled next to the old one and swapped in at the
+# end, so a build reading it at the same time never sees a half-unpacked tree.
 # Needs root (or sudo) once, for dpkg --add-architecture and apt-get update.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -33,8 +35,14 @@ DEBS="$PWD/build/sysroot/.debs-$DIR_NAME"
 
 # Top-level packages; their runtime dependencies are added below.
 TOP=(libgpiod-dev libgpiod2 libturbojpeg0-dev libturbojpeg0)  # libgpiod2 ships libgpiodcxx.so.1
+# Recording format (hal/recording, the replay/calibrate tools, tacse3d --record).
+TOP+=(libspng-dev libspng0)
+# The daemon's sd_notify (READY=1, WATCHDOG=1).
+TOP+=(libsystemd-dev libsystemd0)
 if [ "$WITH_LIBCAMERA" = 1 ]; then TOP+=(libcamera-dev libcamera0.0.3); fi
-# Provided by the cross toolchain (g++-<triple>): never mix a second copy into the sysroot.
+# Provided by the cross toolchain (g++-<triple>): never mix a second copy into the sysroot, and
+# never follow their dependencies (libspng-dev -> zlib1g-dev -> libc6-dev would otherwise drag in
+# libcrypt-dev, libtirpc-dev, libssl3, krb5... next to the toolchain's libc).
 SKIP_RE='^(libc6|libc6-dev|libgcc-s1|libstdc\+\+6|gcc-12-base|linux-libc-dev|libcrypt1)$'
 
 if ! dpkg --print-foreign-architectures | grep -qx "$DEB_ARCH"; then
@@ -52,11 +60,25 @@ mkdir -p "$DEBS"
 APTC=(-o "Dir::Cache::pkgcache=$DEBS/.pkgcache.bin" -o "Dir::Cache::srcpkgcache=$DEBS/.srcpkgcache.bin")
 rm -f "$DEBS/.pkgcache.bin" "$DEBS/.srcpkgcache.bin"
 
-qualified=()
-for p in "${TOP[@]}"; do qualified+=("$p:$DEB_ARCH"); done
-mapfile -t ALL < <(apt-cache "${APTC[@]}" depends --recurse --no-recommends --no-suggests --no-conflicts \
-  --no-breaks --no-replaces --no-enhances "${qualified[@]}" 2>/dev/null |
-  grep -v '^ ' | grep -v '^<' | sed 's/:.*$//' | sort -u)
+# Dependency closure, one apt-cache call per level; skipped packages are not expanded.
+declare -A seen=()
+ALL=()
+frontier=()
+for p in "${TOP[@]}"; do seen[$p]=1; frontier+=("$p"); done
+while [ ${#frontier[@]} -gt 0 ]; do
+  ALL+=("${frontier[@]}")
+  qualified=()
+  for p in "${frontier[@]}"; do
+    if [[ ! "$p" =~ $SKIP_RE ]]; then qualified+=("$p:$DEB_ARCH"); fi
+  done
+  frontier=()
+  [ ${#qualified[@]} -gt 0 ] || break
+  while read -r dep; do
+    if [ -z "${seen[$dep]:-}" ]; then seen[$dep]=1; frontier+=("$dep"); fi
+  done < <(apt-cache "${APTC[@]}" depends --no-recommends --no-suggests --no-conflicts --no-breaks \
+    --no-replaces --no-enhances "${qualified[@]}" 2>/dev/null |
+    sed -n 's/^ *|\{0,1\}\(Pre\)\{0,1\}Depends: \([^<][^ :]*\).*$/\2/p' | sort -u)
+done
 if [ ${#ALL[@]} -eq 0 ]; then
   echo "make-sysroot: apt-cache knows none of ${TOP[*]} for $DEB_ARCH; run apt-get update" >&2
   exit 1
@@ -76,7 +98,11 @@ deb_of() { # package version -> cached .deb path (apt-get download escapes ':' a
   echo "$DEBS/${1}_${2//:/%3a}_${DEB_ARCH}.deb"
 }
 
-rm -rf "${SYSROOT:?}"  # always rebuilt from the cached .debs: no stale files, no merged-dir surprises
+# Always rebuilt from the cached .debs (no stale files, no merged-dir surprises), in a staging
+# directory that replaces the live one only once it is complete.
+FINAL="$SYSROOT"
+SYSROOT="$FINAL.new"
+rm -rf "${SYSROOT:?}"
 mkdir -p "$SYSROOT"
 # Download only what the cache lacks (the cache keeps the exact versions this sysroot holds).
 dl=()
@@ -125,7 +151,26 @@ done < <(find "$SYSROOT" -type l -print0)
   sort "$SYSROOT/.tacse3-sysroot.tmp"
 } >"$SYSROOT/.tacse3-sysroot"
 rm -f "$SYSROOT/.tacse3-sysroot.tmp"
-for lib in libgpiodcxx.so libturbojpeg.so libcamera.so; do
-  if [ -e "$SYSROOT/usr/lib/$TRIPLE/$lib" ]; then echo "  found $lib"; fi
+missing=0
+for lib in libgpiodcxx.so libturbojpeg.so libspng.so libsystemd.so libcamera.so; do
+  if [ -e "$SYSROOT/usr/lib/$TRIPLE/$lib" ]; then
+    echo "  found $lib"
+  elif [ "$lib" != libcamera.so ] || [ "$WITH_LIBCAMERA" = 1 ]; then
+    echo "make-sysroot: $lib missing from $SYSROOT/usr/lib/$TRIPLE" >&2
+    missing=1
+  fi
 done
-echo "make-sysroot: done. Configure with -DTACSE3_TARGET_SYSROOT=$SYSROOT (the default for this arch)."
+if [ "$missing" = 1 ]; then
+  echo "make-sysroot: incomplete sysroot left in $SYSROOT; $FINAL is unchanged" >&2
+  exit 1
+fi
+
+# Swap with two renames: a concurrent build sees the old tree or the new one (or, for the instant
+# between the renames, none), never a half-unpacked one.
+if [ -e "$FINAL" ]; then
+  rm -rf "${FINAL:?}.old"
+  mv "$FINAL" "$FINAL.old"
+fi
+mv "$SYSROOT" "$FINAL"
+rm -rf "${FINAL:?}.old"
+echo "make-sysroot: done. Configure with -DTACSE3_TARGET_SYSROOT=$FINAL (the default for this arch)."
