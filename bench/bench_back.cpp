@@ -89,8 +89,10 @@ BENCHMARK(BM_ContactDetect);
 void BM_MotionUpdate(benchmark::State& state) {
   const Scene& s = scene();
   Calibration cal;
-  cal.velocity_proxy =
-      state.range(0) != 0 ? VelocityProxy::kDisplacement : VelocityProxy::kVelocity;
+  // 0 = velocity, 1 = displacement, 2 = auto (stick/slip detector and deficit bookkeeping).
+  cal.velocity_proxy = state.range(0) == 2   ? VelocityProxy::kAuto
+                       : state.range(0) == 1 ? VelocityProxy::kDisplacement
+                                             : VelocityProxy::kVelocity;
   auto det = std::make_unique<ContactDetector>();
   auto cs = std::make_unique<ContactSet>();
   auto me = std::make_unique<MotionEstimator>();
@@ -102,7 +104,7 @@ void BM_MotionUpdate(benchmark::State& state) {
     benchmark::DoNotOptimize(out.omega.data());
   }
 }
-BENCHMARK(BM_MotionUpdate)->Arg(0)->Arg(1)->ArgName("displacement");
+BENCHMARK(BM_MotionUpdate)->Arg(0)->Arg(1)->Arg(2)->ArgName("proxy");
 
 void BM_Solve3(benchmark::State& state) {
   Eigen::Matrix3d A;

@@ -33,7 +33,16 @@ Status validate(const Calibration& c) noexcept {
   ok = ok && in_range(c.height_gain_m, 0.0, 1.0);
   ok = ok && in_range(c.height_max_m, 0.0, 1e-2);
   ok = ok && (c.velocity_proxy == VelocityProxy::kVelocity ||
-              c.velocity_proxy == VelocityProxy::kDisplacement);
+              c.velocity_proxy == VelocityProxy::kDisplacement ||
+              c.velocity_proxy == VelocityProxy::kAuto);
+  ok = ok && in_range_open_lo(c.slip_relax_rate_on, 0.0, 1e3);
+  ok = ok && c.slip_on_frames >= 1 && c.slip_on_frames <= 1000;
+  ok = ok && in_range(c.slip_min_shift_m, 0.0, 0.01);
+  ok = ok && in_range(c.slip_exit_fraction, 0.0, 1.0);
+  ok = ok && in_range_open_lo(c.stick_rest_speed_m_s, 0.0, 1.0);
+  ok = ok && in_range(c.stick_confirm_s, 0.0, 10.0);
+  ok = ok && c.slip_catchup_frames >= 1 && c.slip_catchup_frames <= 1000;
+  ok = ok && in_range(c.slip_smoothing_s, 0.0, 1.0);
   ok = ok && in_range_open_lo(c.c_velocity, 0.0, 100.0);
   ok = ok && in_range_open_lo(c.c_displacement, 0.0, 1.0);
   ok = ok && in_range(c.max_mask_change, 0.0, 1.0);

@@ -23,7 +23,9 @@ Status validate(const PipelineConfig& config) noexcept {
   return Status::kOk;
 }
 
-SensorPipeline::SensorPipeline() noexcept { (void)configure(PipelineConfig{}, Calibration{}); }
+SensorPipeline::SensorPipeline() noexcept {
+  (void)configure(PipelineConfig{}, Calibration{});
+}
 
 Status SensorPipeline::configure(const PipelineConfig& config, const Calibration& cal) noexcept {
   if (validate(config) != Status::kOk) return Status::kBadArgument;
@@ -83,7 +85,9 @@ void SensorPipeline::tare() noexcept {
   motion_.reset();
 }
 
-void SensorPipeline::restart_motion() noexcept { motion_.reset(); }
+void SensorPipeline::restart_motion() noexcept {
+  motion_.reset();
+}
 
 void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& out) noexcept {
   out = SensorResult{};
@@ -131,6 +135,7 @@ void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& 
   const double dt = (std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= 1.0) ? dt_s : 1.0 / 120.0;
   // Stages 7-8: centroid translation, velocity proxy, moments and the own-frame ω solve.
   (void)motion_.update(fields_.contact, fields_.shear, dt, out.motion);
+  out.slipping = out.motion.slipping;
 }
 
 Status validate(const DualConfig& config) noexcept {
@@ -200,6 +205,7 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
   const SensorMotion* motions[2] = {nullptr, nullptr};
   for (std::size_t i = 0; i < 2; ++i) {
     SensorResult& r = out.sensors[i];
+    out.slipping[i] = false;
     if (frames[i] == nullptr) {
       r = SensorResult{};
       // A sensor that misses a cycle must not difference its next frame against a stale one.
@@ -209,6 +215,7 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
     if (gap) sensors_[i].restart_motion();
     sensors_[i].process(*frames[i], dt, r);
     if (r.processed && !r.degraded) motions[i] = &r.motion;
+    out.slipping[i] = r.slipping;
   }
 
   // Fusion (Sec. V-C) in G; an absent sensor gives the flagged single-sensor mode.
@@ -230,7 +237,9 @@ void DualPipeline::tare() noexcept {
   average_.reset();
 }
 
-void DualPipeline::reset_pose() noexcept { integrator_.reset(); }
+void DualPipeline::reset_pose() noexcept {
+  integrator_.reset();
+}
 
 Status DualPipeline::set_finger_separation(double separation_m) noexcept {
   if (!finite_in(separation_m, 0.0, 0.5)) return Status::kBadArgument;
@@ -247,7 +256,8 @@ Status DualPipeline::set_fusion_method(FusionMethod method) noexcept {
 }
 
 Status DualPipeline::set_velocity_proxy(VelocityProxy mode) noexcept {
-  if (mode != VelocityProxy::kVelocity && mode != VelocityProxy::kDisplacement) {
+  if (mode != VelocityProxy::kVelocity && mode != VelocityProxy::kDisplacement &&
+      mode != VelocityProxy::kAuto) {
     return Status::kBadArgument;
   }
   std::array<Calibration, 2> cal = cal_;

@@ -52,6 +52,11 @@ cfg::CalibrationSet odd_set() {
   }
   s.sensor[1].c_velocity = 0.0081;  // a per-sensor difference goes to [right]
   s.sensor[1].translation_scale = {1.1, 0.9, 1.0};
+  // The stick/slip detector's mode and thresholds round-trip too (one pad differs).
+  s.sensor[1].velocity_proxy = dsp::VelocityProxy::kAuto;
+  s.sensor[1].slip_relax_rate_on = 2.5;
+  s.sensor[1].slip_on_frames = 6;
+  s.sensor[1].stick_confirm_s = 0.75;
   s.paper[0].rotation_scale = {0.03, 0.025, 1.2};
   s.paper[1].rotation_scale = {0.03, 0.025, 1.2};
   s.paper[1].translation_scale = {1.5, 1.0, 1.0};
@@ -78,6 +83,14 @@ void expect_same(const dsp::Calibration& a, const dsp::Calibration& b) {
   EXPECT_EQ(a.velocity_proxy, b.velocity_proxy);
   EXPECT_EQ(a.c_velocity, b.c_velocity);
   EXPECT_EQ(a.c_displacement, b.c_displacement);
+  EXPECT_EQ(a.slip_relax_rate_on, b.slip_relax_rate_on);
+  EXPECT_EQ(a.slip_on_frames, b.slip_on_frames);
+  EXPECT_EQ(a.slip_min_shift_m, b.slip_min_shift_m);
+  EXPECT_EQ(a.slip_exit_fraction, b.slip_exit_fraction);
+  EXPECT_EQ(a.stick_rest_speed_m_s, b.stick_rest_speed_m_s);
+  EXPECT_EQ(a.stick_confirm_s, b.stick_confirm_s);
+  EXPECT_EQ(a.slip_catchup_frames, b.slip_catchup_frames);
+  EXPECT_EQ(a.slip_smoothing_s, b.slip_smoothing_s);
   EXPECT_EQ(a.max_mask_change, b.max_mask_change);
   EXPECT_EQ(a.rotation_scale, b.rotation_scale);
   EXPECT_EQ(a.translation_scale, b.translation_scale);
@@ -115,7 +128,9 @@ TEST(CalibrationFile, RoundTripIsExact) {
   EXPECT_EQ(out.meta.recordings, in.meta.recordings);
   // Shared values are written once in [sensor], differing ones per sensor.
   EXPECT_NE(text.find("[sensor]\npixel_pitch_m = 1e-04\n"), std::string::npos) << text;
-  EXPECT_NE(text.find("[right]\nc_velocity = 0.0081\ntranslation_scale = [1.1, 0.9, 1.0]"),
+  EXPECT_NE(text.find("[right]\nvelocity_proxy = \"auto\"\nc_velocity = 0.0081\n"
+                      "slip_relax_rate_on = 2.5\nslip_on_frames = 6\nstick_confirm_s = 0.75\n"
+                      "translation_scale = [1.1, 0.9, 1.0]"),
             std::string::npos)
       << text;
   EXPECT_NE(text.find("velocity_proxy = \"displacement\""), std::string::npos);
@@ -269,9 +284,15 @@ TEST(CalibrationFile, EveryPrefixAndByteFlipFailsCleanly) {
 TEST(CalibrationFile, EveryCalibrationFieldHasAKey) {
   // If dsp::Calibration gains a field, the file must learn it (this list is the file's).
   const auto keys = cfg::sensor_keys();
-  EXPECT_EQ(keys.size(), 22u);
+  EXPECT_EQ(keys.size(), 30u);
   EXPECT_EQ(keys.front(), "pixel_pitch_m");
   EXPECT_EQ(std::count(keys.begin(), keys.end(), "velocity_proxy"), 1);
+  // The eight thresholds of the stick/slip detector (VelocityProxy::kAuto).
+  for (const char* k :
+       {"slip_relax_rate_on", "slip_on_frames", "slip_min_shift_m", "slip_exit_fraction",
+        "stick_rest_speed_m_s", "stick_confirm_s", "slip_catchup_frames", "slip_smoothing_s"}) {
+    EXPECT_EQ(std::count(keys.begin(), keys.end(), k), 1) << k;
+  }
 }
 
 }  // namespace

@@ -408,6 +408,43 @@ int main(int argc, char** argv) {
         ref_cell(r.res(r.slot.dual_joint)).c_str());
     add(line);
   }
+  // ---- stick/slip detector -------------------------------------------------------------------
+  {
+    add("");
+    add("### Stick/slip detector (defaults, dual): per-frame agreement with the simulator's label");
+    add("");
+    add("Sensor-frames in contact, both pads; `slip found` = frames labelled slipping that the "
+        "detector called slipping, `stick found` likewise. The label is the simulator's: slide "
+        "regime and sliding speed above 0.5 mm/s on most of the patch.");
+    add("");
+    add("| recording | regime | frames | accuracy | slip found | stick found |");
+    add("|---|---|---|---|---|---|");
+    tt::SlipScore stick_all, slide_all;
+    for (const auto& r : rows) {
+      const tt::EvalResult& e = r.res(r.slot.dual_joint);
+      if (!e.slip_scored) continue;
+      const bool slide = e.slip.true_slip + e.slip.false_stick > 0;
+      (slide ? slide_all : stick_all).merge(e.slip);
+      std::snprintf(line, sizeof(line), "| %s | %s | %lld | %.1f %% | %lld/%lld | %lld/%lld |",
+                    r.c.label().c_str(), slide ? "slide" : "stick",
+                    static_cast<long long>(e.slip.scored()), 100.0 * e.slip.accuracy(),
+                    static_cast<long long>(e.slip.true_slip),
+                    static_cast<long long>(e.slip.true_slip + e.slip.false_stick),
+                    static_cast<long long>(e.slip.true_stick),
+                    static_cast<long long>(e.slip.true_stick + e.slip.false_slip));
+      add(line);
+    }
+    for (const auto* all : {&slide_all, &stick_all}) {
+      std::snprintf(line, sizeof(line),
+                    "| **all %s recordings** | | %lld | %.1f %% | %lld/%lld | %lld/%lld |",
+                    all == &slide_all ? "slide" : "stick", static_cast<long long>(all->scored()),
+                    100.0 * all->accuracy(), static_cast<long long>(all->true_slip),
+                    static_cast<long long>(all->true_slip + all->false_stick),
+                    static_cast<long long>(all->true_stick),
+                    static_cast<long long>(all->true_stick + all->false_slip));
+      add(line);
+    }
+  }
   // ---- goals --------------------------------------------------------------------------------
   add("");
   add("### Goals (defaults: `--method joint --mode auto`, dual sensor)");

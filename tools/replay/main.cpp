@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
       "Replays a tacse3 recording through the firmware's fixed-point pipeline (dsp::DualPipeline) "
       "and writes the estimated twist and pose per frame (docs/replay.md)."};
   std::string rec_dir, cal_file, out_file, method = "joint", mode = "auto", sensors = "both";
-  std::string dump_dir, can_log;
+  std::string dump_dir, can_log, slip_log;
   bool quiet = false;
   app.add_option("REC_DIR", rec_dir, "recording directory (docs/recording-format.md)")->required();
   app.add_option("--calibration", cal_file,
@@ -51,6 +51,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"both", "left", "right"}));
   app.add_option("--dump-fields", dump_dir, "write per-frame fields as .npy files into DIR");
   app.add_option("--can-log", can_log, "write the firmware's CAN frames as a candump -L log");
+  app.add_option("--slip-log", slip_log,
+                 "write the stick/slip detector's per-frame decision and features as CSV");
   app.add_flag("-q,--quiet", quiet, "no progress bar and no summary");
   CLI11_PARSE(app, argc, argv);
 
@@ -93,6 +95,26 @@ int main(int argc, char** argv) {
     if (err = can.open(can_log, opt.method, opt.mode); !err.empty()) return fail(err);
     sinks.can = &can;
   }
+  std::FILE* slip = nullptr;
+  if (!slip_log.empty()) {
+    slip = std::fopen(slip_log.c_str(), "w");
+    if (slip == nullptr) return fail(slip_log + ": cannot open for writing");
+    std::fprintf(slip,
+                 "t_ns,sensor,contact,slipping,onset,stick_confirmed,relax_rate_per_s,shift_m,"
+                 "rate_m_s\n");
+    sinks.on_frame = [slip](std::size_t, const tt::FrameResult& r, const tt::Replayer& engine) {
+      const auto& res = engine.result();
+      for (int k = 0; k < 2; ++k) {
+        const auto& sr = res.sensors[static_cast<std::size_t>(k)];
+        if (!res.present[static_cast<std::size_t>(k)]) continue;
+        const auto& m = sr.motion;
+        std::fprintf(slip, "%lld,%s,%d,%d,%d,%d,%.6g,%.6g,%.6g\n", static_cast<long long>(r.t_ns),
+                     k == 0 ? "left" : "right", m.contact ? 1 : 0, sr.slipping ? 1 : 0,
+                     m.slip_onset ? 1 : 0, m.stick_confirmed ? 1 : 0, m.slip_relax_rate,
+                     m.shear_shift_m, m.shear_rate_m_s);
+      }
+    };
+  }
   tt::ProgressBar bar("tacse3-replay", static_cast<std::int64_t>(info.frame_count()),
                       !quiet && tt::stderr_is_tty());
   sinks.progress = &bar;
@@ -101,6 +123,7 @@ int main(int argc, char** argv) {
   bar.finish();
   if (!to_stdout && std::fclose(csv) != 0) return fail(out_file + ": write error");
   if (to_stdout) std::fflush(stdout);
+  if (slip != nullptr && std::fclose(slip) != 0) return fail(slip_log + ": write error");
   if (!run.error.empty()) return fail(run.error);
   if (sinks.dump != nullptr) {
     if (err = dumper.close(); !err.empty()) return fail(err);

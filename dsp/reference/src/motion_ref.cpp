@@ -3,6 +3,7 @@
 #include "tacse3/dsp_ref/motion_ref.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 #include "tacse3/dsp/fixed.hpp"
@@ -71,6 +72,20 @@ MotionRef::MotionRef(const dsp::Calibration& cal) : cal_(cal) {
   reset();
 }
 
+void MotionRef::reset_detector() {
+  const auto n = static_cast<std::size_t>(dsp::kGridCount);
+  slipping_ = false;
+  evidence_frames_ = 0;
+  rest_s_ = 0.0;
+  peak_shift_m_ = 0.0;
+  catchup_left_ = 0;
+  deficit_x_.assign(n, 0.0);
+  deficit_y_.assign(n, 0.0);
+  deficit_t_.setZero();
+  content_.setZero();
+  have_content_ = false;
+}
+
 void MotionRef::reset() {
   const auto n = static_cast<std::size_t>(dsp::kGridCount);
   prev_mask_.assign(n, 0);
@@ -78,17 +93,25 @@ void MotionRef::reset() {
   prev_sx_.assign(n, 0.0);
   prev_sy_.assign(n, 0.0);
   have_prev_shear_ = false;
+  reset_detector();
 }
 
 SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<double>& shear_x,
                                   const std::vector<double>& shear_y, double dt) {
   const auto n = static_cast<std::size_t>(dsp::kGridCount);
-  const bool disp = cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
+  const bool automatic = cal_.velocity_proxy == dsp::VelocityProxy::kAuto;
   SensorMotionRef out;
-  out.proxy_valid = !disp || have_prev_shear_;
+  // kAuto bookkeeping with the state of the previous frames (dsp::MotionEstimator's rules).
+  const bool accumulate = automatic && !slipping_ && have_prev_shear_;
+  const int left = automatic && slipping_ ? catchup_left_ : 0;
+  const double g = cal_.c_velocity * dt / cal_.c_displacement;
+  const double h = cal_.c_displacement / (cal_.c_velocity * dt);
   int prev_count = 0, common = 0;
   Eigen::Vector3d sum_now = Eigen::Vector3d::Zero(), sum_prev = Eigen::Vector3d::Zero();
   Eigen::Vector3d sum_common = Eigen::Vector3d::Zero();
+  // Per point: shear (velocity reading), increment (displacement reading), payback.
+  std::vector<PointSample> shear_pts, incr_pts;
+  std::vector<Eigen::Vector3d> payback;
   for (std::size_t i = 0; i < n; ++i) {
     if (prev_mask_[i] != 0) {
       ++prev_count;
@@ -97,21 +120,108 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     if (c.mask[i] == 0) continue;
     PointSample s;
     s.q = c.q[i];
-    if (!disp) {
-      s.v = cal_.c_velocity * Eigen::Vector3d(shear_x[i], shear_y[i], 0.0);
-    } else if (have_prev_shear_) {
-      s.v = cal_.c_displacement / dt *
-            Eigen::Vector3d(shear_x[i] - prev_sx_[i], shear_y[i] - prev_sy_[i], 0.0);
+    const Eigen::Vector3d sv(shear_x[i], shear_y[i], 0.0);
+    Eigen::Vector3d dv = Eigen::Vector3d::Zero();
+    if (have_prev_shear_)
+      dv = Eigen::Vector3d(shear_x[i] - prev_sx_[i], shear_y[i] - prev_sy_[i], 0.0);
+    s.v = sv;
+    shear_pts.push_back(s);
+    s.v = dv;
+    incr_pts.push_back(s);
+    Eigen::Vector3d pay = Eigen::Vector3d::Zero();
+    if (accumulate) {
+      deficit_x_[i] += g * sv.x() - dv.x();
+      deficit_y_[i] += g * sv.y() - dv.y();
+    } else if (left > 0) {
+      const double px = deficit_x_[i] / left, py = deficit_y_[i] / left;
+      deficit_x_[i] -= px;
+      deficit_y_[i] -= py;
+      pay = Eigen::Vector3d(h * px, h * py, 0.0);
     }
-    out.samples.push_back(s);
+    payback.push_back(pay);
     sum_now += s.q;
     if (prev_mask_[i] != 0) {
       ++common;
       sum_common += s.q - prev_q_[i];
     }
   }
-  out.points = static_cast<int>(out.samples.size());
+  out.points = static_cast<int>(shear_pts.size());
   out.contact = out.points > 0;
+  const double lambda_floor = out.points * cal_.solve_lever_floor_m * cal_.solve_lever_floor_m;
+  auto solve = [&](const std::vector<PointSample>& pts) {
+    const StackedSystem sys = stack_shear_rows(pts);
+    const Eigen::Matrix3d AtA = sys.A.transpose() * sys.A;
+    return solve_stacked(sys, cal_.solve_lambda_rel * AtA.trace() / 3.0 + lambda_floor);
+  };
+
+  const bool sticking =
+      automatic ? !slipping_ : cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
+  if (automatic) {
+    if (out.points == 0) {
+      reset_detector();
+    } else {
+      // Planar rigid-body content of the shear read as a contact displacement (brute force).
+      const double np = static_cast<double>(out.points);
+      const Eigen::Vector3d cen = sum_now / np;
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      double torque = 0.0, inertia = 0.0;
+      for (const auto& p : shear_pts) {
+        const Eigen::Vector2d r = (p.q - cen).head<2>();
+        const Eigen::Vector2d v = cal_.c_displacement * p.v.head<2>();
+        mean += v;
+        torque += r.x() * v.y() - r.y() * v.x();
+        inertia += r.squaredNorm();
+      }
+      mean /= np;
+      const Eigen::Vector3d raw(inertia > 0.0 ? torque / std::sqrt(np * inertia) : 0.0, mean.x(),
+                                mean.y());
+      const Eigen::Vector3d before = content_;
+      const double alpha = cal_.slip_smoothing_s > 0.0 ? dt / (cal_.slip_smoothing_s + dt) : 1.0;
+      content_ = have_content_ ? Eigen::Vector3d(content_ + alpha * (raw - content_)) : raw;
+      const Eigen::Vector3d change =
+          have_content_ ? Eigen::Vector3d(content_ - before) : Eigen::Vector3d::Zero();
+      have_content_ = true;
+      const double x2 = content_.squaredNorm();
+      out.shear_shift_m = std::sqrt(x2);
+      out.shear_rate_m_s = change.norm() / dt;
+      out.slip_relax_rate = x2 > 0.0 ? -content_.dot(change) / (x2 * dt) : 0.0;
+      const bool rest = out.shear_rate_m_s < cal_.stick_rest_speed_m_s;
+      if (!slipping_) {
+        const bool relaxing = out.shear_shift_m > cal_.slip_min_shift_m &&
+                              out.slip_relax_rate > cal_.slip_relax_rate_on;
+        evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
+        rest_s_ = rest ? rest_s_ + dt : 0.0;
+        if (evidence_frames_ >= cal_.slip_on_frames) {
+          slipping_ = true;
+          out.slip_onset = true;
+          evidence_frames_ = 0;
+          peak_shift_m_ = out.shear_shift_m;
+          catchup_left_ = cal_.slip_catchup_frames;
+        } else if (rest_s_ >= cal_.stick_confirm_s) {
+          out.stick_confirmed = true;
+          std::fill(deficit_x_.begin(), deficit_x_.end(), 0.0);
+          std::fill(deficit_y_.begin(), deficit_y_.end(), 0.0);
+          deficit_t_.setZero();
+        }
+      } else {
+        peak_shift_m_ = std::max(peak_shift_m_, out.shear_shift_m);
+        if (rest && out.shear_shift_m <= cal_.slip_exit_fraction * peak_shift_m_) reset_detector();
+      }
+    }
+    out.slipping = !sticking;
+  }
+  const bool paying = left > 0;
+  out.proxy_valid = !sticking || have_prev_shear_;
+  out.samples = sticking ? incr_pts : shear_pts;
+  for (std::size_t k = 0; k < out.samples.size(); ++k) {
+    PointSample& p = out.samples[k];
+    if (sticking) {
+      p.v *= have_prev_shear_ ? cal_.c_displacement / dt : 0.0;
+    } else {
+      p.v = cal_.c_velocity * (p.v + (paying ? payback[k] : Eigen::Vector3d::Zero()));
+    }
+  }
+
   const Eigen::Vector3d tscale(cal_.translation_scale[0], cal_.translation_scale[1],
                                cal_.translation_scale[2]);
   const Eigen::Vector3d wscale(cal_.rotation_scale[0], cal_.rotation_scale[1],
@@ -119,31 +229,39 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   if (out.points > 0 && prev_count > 0) {
     const int uni = out.points + prev_count - common;
     const double change = 1.0 - static_cast<double>(common) / uni;
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    const bool sticking = cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
-    if (sticking && common > 0) {
-      d = sum_common / common;
-      out.translation_source = 2;
-      out.translation_valid = true;
-    } else if (change <= cal_.max_mask_change) {
-      d = sum_now / out.points - sum_prev / prev_count;
-      out.translation_source = 1;
-      out.translation_valid = true;
+    Eigen::Vector3d slide = Eigen::Vector3d::Zero(), common_d = Eigen::Vector3d::Zero();
+    int slide_source = 0;
+    if (common > 0) common_d = sum_common / common;
+    if (change <= cal_.max_mask_change) {
+      slide = sum_now / out.points - sum_prev / prev_count;
+      slide_source = 1;
     } else if (common > 0) {
-      d = sum_common / common;
+      slide = common_d;
+      slide_source = 2;
+    }
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    if (sticking && common > 0) {
+      d = common_d;
       out.translation_source = 2;
       out.translation_valid = true;
+      if (automatic && slide_source != 0) deficit_t_ += (slide - common_d).head<2>();
+    } else if (slide_source != 0) {
+      d = slide;
+      out.translation_source = slide_source;
+      out.translation_valid = true;
+    }
+    if (paying) {
+      const Eigen::Vector2d pay = deficit_t_ / static_cast<double>(left);
+      deficit_t_ -= pay;
+      d.head<2>() += pay;
     }
     d.z() = 0.0;
     out.translation = tscale.cwiseProduct(d / dt);
   }
+  if (paying && slipping_) catchup_left_ = left - 1;  // (an exit this frame reset it)
   if (out.points > 0) {
     out.centroid = sum_now / out.points;
-    const StackedSystem sys = stack_shear_rows(out.samples);
-    const Eigen::Matrix3d AtA = sys.A.transpose() * sys.A;
-    const double lambda = cal_.solve_lambda_rel * AtA.trace() / 3.0 +
-                          out.points * cal_.solve_lever_floor_m * cal_.solve_lever_floor_m;
-    out.omega = wscale.cwiseProduct(solve_stacked(sys, lambda));
+    out.omega = wscale.cwiseProduct(solve(out.samples));
   }
   prev_mask_ = c.mask;
   prev_q_ = c.q;

@@ -64,6 +64,17 @@ const std::vector<Field>& fields() {
       {"velocity_proxy", Field::kProxy, 0, 0, false, false},
       {"c_velocity", Field::kReal, 0.0, 100.0, true, false, &Calibration::c_velocity},
       {"c_displacement", Field::kReal, 0.0, 1.0, true, false, &Calibration::c_displacement},
+      {"slip_relax_rate_on", Field::kReal, 0.0, 1e3, true, false, &Calibration::slip_relax_rate_on},
+      {"slip_on_frames", Field::kInt, 1, 1000, false, false, nullptr, &Calibration::slip_on_frames},
+      {"slip_min_shift_m", Field::kReal, 0.0, 0.01, false, false, &Calibration::slip_min_shift_m},
+      {"slip_exit_fraction", Field::kReal, 0.0, 1.0, false, false,
+       &Calibration::slip_exit_fraction},
+      {"stick_rest_speed_m_s", Field::kReal, 0.0, 1.0, true, false,
+       &Calibration::stick_rest_speed_m_s},
+      {"stick_confirm_s", Field::kReal, 0.0, 10.0, false, false, &Calibration::stick_confirm_s},
+      {"slip_catchup_frames", Field::kInt, 1, 1000, false, false, nullptr,
+       &Calibration::slip_catchup_frames},
+      {"slip_smoothing_s", Field::kReal, 0.0, 1.0, false, false, &Calibration::slip_smoothing_s},
       {"max_mask_change", Field::kReal, 0.0, 1.0, false, false, &Calibration::max_mask_change},
       {"rotation_scale", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
        &Calibration::rotation_scale},
@@ -87,6 +98,7 @@ struct ProxyName {
 constexpr ProxyName kProxyNames[] = {
     {dsp::VelocityProxy::kVelocity, "velocity"},
     {dsp::VelocityProxy::kDisplacement, "displacement"},
+    {dsp::VelocityProxy::kAuto, "auto"},
 };
 
 std::string fmt_real(double v) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <iterator>
 #include <mutex>
 #include <numbers>
 #include <thread>
@@ -641,11 +642,67 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     rep.recordings[r].before_deg = rotation_error_deg(
         out0[r][static_cast<std::size_t>(fit.p.mode[r])].final_pose.q, dsp::so3_exp(data[r].theta));
   }
-  // The slip detector's thresholds are fitted here once dsp::VelocityProxy::kAuto exists: run
-  // kAuto with the gains above and choose the thresholds that minimise the same integrated-
-  // rotation cost, with each frame's proxy chosen by the detector (docs/calibration.md).
-  rep.notes.push_back(
-      "slip detector thresholds: not fitted (the pipeline has no VelocityProxy::kAuto yet)");
+  // ---- stick/slip detector thresholds (label-free) -------------------------------------------
+  // kAuto runs with the fitted gains over every recording, once per candidate onset threshold
+  // (ρ_on, frames); the candidate with the smallest summed final-pose error (the same relative
+  // rotation and translation cost that chose each recording's proxy above) wins. Only truth
+  // poses are used, never a regime label.
+  log("stage 2b/3: stick/slip detector thresholds (kAuto, one run per candidate)");
+  struct DetectorCandidate {
+    double relax_rate_on;
+    int on_frames;
+  };
+  static constexpr DetectorCandidate kCandidates[] = {{1.5, 3}, {1.5, 6}, {2.5, 3}, {2.5, 6},
+                                                      {4.0, 3}, {4.0, 6}, {6.0, 3}, {6.0, 6}};
+  constexpr std::size_t kCandidateCount = std::size(kCandidates);
+  std::vector<std::vector<RunOutput>> outd(n);
+  err = run_stage(sources, opt, "calibrate 2b/3", [&](std::size_t r, auto* done) {
+    std::vector<ReplayOptions> cfg;
+    for (const auto& cand : kCandidates) {
+      ReplayOptions o;
+      o.calibration = fitted;
+      for (auto& c : o.calibration.sensor) {
+        c.slip_relax_rate_on = cand.relax_rate_on;
+        c.slip_on_frames = cand.on_frames;
+      }
+      o.method = dsp::FusionMethod::kJoint;
+      o.mode = ProxyMode::kAuto;
+      for (auto& p : o.calibration.paper) p = config::PaperScales{};
+      cfg.push_back(o);
+    }
+    return run_pass(*sources[r], cfg, done, nullptr, &outd[r]);
+  });
+  if (!err.empty()) return err;
+  {
+    std::array<double, kCandidateCount> cost{};
+    for (std::size_t k = 0; k < kCandidateCount; ++k) {
+      for (std::size_t r = 0; r < n; ++r) {
+        const dsp::Pose& e = outd[r][k].final_pose;
+        const double rot = rotation_error_deg(e.q, dsp::so3_exp(data[r].theta)) / kDeg /
+                           std::max(data[r].theta.norm(), kWeightFloorRad);
+        const double tr = (e.p - truth_p[r]).norm() / std::max(truth_p[r].norm(), 1e-3);
+        cost[k] += rot * rot + tr * tr;
+      }
+    }
+    const auto best =
+        static_cast<std::size_t>(std::min_element(cost.begin(), cost.end()) - cost.begin());
+    for (auto& c : fitted.sensor) {
+      c.slip_relax_rate_on = kCandidates[best].relax_rate_on;
+      c.slip_on_frames = kCandidates[best].on_frames;
+    }
+    char line[160];
+    std::string text =
+        "slip detector (kAuto) onset thresholds: cost per candidate (rho_on/s, frames):";
+    for (std::size_t k = 0; k < kCandidateCount; ++k) {
+      std::snprintf(line, sizeof(line), " %.1f/%d=%.3f", kCandidates[k].relax_rate_on,
+                    kCandidates[k].on_frames, cost[k]);
+      text += line;
+    }
+    std::snprintf(line, sizeof(line), " -> slip_relax_rate_on %.1f, slip_on_frames %d",
+                  kCandidates[best].relax_rate_on, kCandidates[best].on_frames);
+    rep.notes.push_back(text + line);
+    rep.detector_cost.assign(cost.begin(), cost.end());
+  }
 
   // ---- stage 2: validation runs; paper-fusion and translation scales -----------------------
   log("stage 3/3: validation runs (joint, paper) with the fitted gains");

@@ -88,20 +88,19 @@ dsp::VelocityProxy pipeline_proxy(ProxyMode m) noexcept {
     case ProxyMode::kVelocity:
       return dsp::VelocityProxy::kVelocity;
     case ProxyMode::kAuto:
-      // Until the pipeline has its own per-frame stick/slip switch, auto runs the sliding-regime
-      // proxy of the paper (dsp's default).
-      return dsp::VelocityProxy::kVelocity;
+      // The pipeline's per-frame, per-sensor stick/slip detector (docs/dsp.md).
+      return dsp::VelocityProxy::kAuto;
   }
   return dsp::VelocityProxy::kVelocity;
 }
 
 bool pipeline_has_auto() noexcept {
-  return false;
+  return true;
 }
 
 std::optional<bool> detected_slip(const dsp::SensorResult& r) noexcept {
-  (void)r;
-  return std::nullopt;
+  if (!r.processed || r.degraded) return std::nullopt;
+  return r.slipping;
 }
 // ---------------------------------------------------------------------------------------------
 

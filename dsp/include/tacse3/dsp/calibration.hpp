@@ -17,6 +17,11 @@ enum class VelocityProxy : std::uint8_t {
   // The increment of the shear field between consecutive frames is the contact displacement,
   // ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt. Exact kinematics while the contact sticks.
   kDisplacement = 1,
+  // Per frame and per sensor: a stick/slip detector (motion.hpp, docs/dsp.md "Stick/slip
+  // detector") picks kDisplacement while the contact sticks and kVelocity while it slips, with
+  // the thresholds below. The velocity proxy's deficit accumulated while a slip still looked like
+  // a stick is paid back over slip_catchup_frames once the slip is detected (no pose jump).
+  kAuto = 2,
 };
 
 // Largest moving-average window (frames). Sizes the ring buffer at compile time.
@@ -64,6 +69,35 @@ struct Calibration {
   // working pixels (1 working px = 2 sensor px). Change it together with pixel_pitch_m. (0, 1]
   double c_displacement = 2.0 * 0.075e-3;
 
+  // --- stick/slip detector of kAuto (docs/dsp.md "Stick/slip detector"). The detector looks at
+  // the planar rigid-body content of the shear field over Ω read as a contact displacement
+  // (c_displacement scaling): X = [L·θ, t_x, t_y], the rotation θ about the pad normal times the
+  // contact's rms lever L and the mean shift t (motion.hpp planar_content), smoothed
+  // exponentially with time constant slip_smoothing_s; dX is the smoothed X's change per frame.
+  // Slip onset: the shear relaxes while loaded, ρ = −X·dX / (|X|² Δt) > slip_relax_rate_on for
+  // slip_on_frames consecutive frames with |X| > slip_min_shift_m. A sticking contact's shear is
+  // the accumulated contact displacement and only shrinks if the object moves back; a sliding
+  // contact's shear follows the sliding speed with the gel's lag, so it relaxes as the slide
+  // slows and when it ends. Ranges: (0, 1e3] 1/s, [1, 1000], [0, 0.01] m.
+  double slip_relax_rate_on = 3.0;
+  int slip_on_frames = 4;
+  double slip_min_shift_m = 20e-6;
+  // Slip end: |X| fell below slip_exit_fraction of its peak during the slip and the field is at
+  // rest, |dX|/Δt < stick_rest_speed_m_s. [0, 1], (0, 1] m/s.
+  double slip_exit_fraction = 0.25;
+  double stick_rest_speed_m_s = 0.05e-3;
+  // A sticking contact whose shear content stayed at rest (|dX|/Δt < stick_rest_speed_m_s) for
+  // stick_confirm_s is confirmed stuck and its pending velocity-proxy deficit is dropped: a slide
+  // relaxes within a few lag times of the gel, a stuck contact holds its shear. [0, 10] s.
+  double stick_confirm_s = 1.0;
+  // Frames over which the deficit (what the velocity proxy would have added while the slip still
+  // looked like a stick) is paid back after a slip onset, so the pose catches up without a jump.
+  // [1, 1000].
+  int slip_catchup_frames = 12;
+  // Time constant of the smoothing of X (s): the per-frame noise of the shear field's rigid
+  // content is ~10 µm, the gel's lag (which a slide's relaxation follows) ~50 ms. [0, 1].
+  double slip_smoothing_s = 0.04;
+
   // --- translation (contact-centroid displacement, paper Sec. IV-D)
   // If the mask changes by more than this fraction between frames (1 − Jaccard index), the
   // mask-centroid displacement is replaced by the mean displacement of the material points in
@@ -85,7 +119,7 @@ struct Calibration {
 };
 
 // kOk, or kBadCalibration if any field is NaN/inf or outside the range documented above
-// (including τ_off > τ_on and an unknown velocity_proxy value).
+// (including τ_off > τ_on, an unknown velocity_proxy value and the detector ranges).
 Status validate(const Calibration& cal) noexcept;
 
 }  // namespace tacse3::dsp

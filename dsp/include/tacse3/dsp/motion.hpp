@@ -55,6 +55,14 @@ MomentSums rigid_transform(const MomentSums& m, const Eigen::Matrix3d& R,
 //   AᵀA = tr(Σqqᵀ) I − Σqqᵀ − [n]× Σqqᵀ [n]×ᵀ,   Aᵀb = Σ q × ṽ   (ṽ ⟂ n).
 void add_normal_equations(const MomentSums& m, Eigen::Matrix3d& AtA, Eigen::Vector3d& Atb) noexcept;
 
+// Planar rigid-body content X = [L·θ, t_x, t_y] (m) of the proxy in `m` read with `scale`
+// (metres per Q16 LSB): t the mean, θ = Σ (r × ṽ)_z / Σ |r|² the rotation about the pad normal
+// through the contact centroid (r = q − c in the pad plane), L = √(Σ |r|² / N) the rms lever, so
+// L·θ = Σ (r × ṽ)_z / √(N Σ |r|²). Used by the kAuto stick/slip detector; zero without points.
+Eigen::Vector3d planar_content(const ContactMoments& m, double scale) noexcept;
+// Weight of the detector's exponential smoothing of X: Δt / (τ + Δt) (1 when τ = 0).
+double content_alpha(double dt_s, double smoothing_s) noexcept;
+
 enum class TranslationSource : std::uint8_t {
   kNone = 0,          // no translation this frame (no contact now or in the previous frame)
   kCentroid = 1,      // displacement of the mask centroid (paper Sec. IV-D)
@@ -79,6 +87,13 @@ struct SensorMotion {
   Solve3Result solve;
   bool rotation_valid = false;  // contact && proxy_valid && solve.valid
   Eigen::Vector3d rotation_scale = Eigen::Vector3d::Ones();  // copied for the joint fusion
+  // --- stick/slip detector (kAuto only; false/0 in the fixed modes).
+  bool slipping = false;         // the velocity proxy was used this frame
+  bool slip_onset = false;       // the detector switched stick → slip this frame
+  bool stick_confirmed = false;  // the shear was held at rest long enough: a stuck contact
+  double slip_relax_rate = 0.0;  // ρ (1/s), relative decay rate of the shear's rigid content
+  double shear_shift_m = 0.0;    // |X| (m), rigid content of the shear read as a displacement
+  double shear_rate_m_s = 0.0;   // |dX|/Δt (m/s), rigid content of this frame's increment
 };
 
 // Per-sensor motion stage. State: previous mask, positions, centroid sums and shear field
@@ -97,6 +112,13 @@ struct SensorMotion {
 //    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt, the previous shear kept per sensor.
 //  - Rotation: int64 moments over Ω, then in double the own-frame normal equations and
 //    solve3 with λ = λ_rel tr/3 + N · lever_floor².
+//  - kAuto (per frame): both proxies' moments are summed in the same pass; the stick/slip
+//    detector (Calibration, docs/dsp.md) picks one. While sticking, the per-cell deficit
+//    A += (c_velocity Δt / c_displacement) · shear − Δshear (Q16 shear units) is kept, i.e. what
+//    the velocity proxy would have read on top of the displacement proxy; at a slip onset it is
+//    paid back as an extra proxy A / k over the next k = slip_catchup_frames frames (the pose
+//    catches up smoothly), and dropped when the stick is confirmed. The translation's deficit
+//    (centroid rule − common-points rule) is kept and paid back the same way.
 class MotionEstimator {
  public:
   MotionEstimator() noexcept;  // configured with Calibration{} defaults
@@ -129,6 +151,27 @@ class MotionEstimator {
   std::int64_t prev_sy_ = 0;
   VectorField prev_shear_;
   bool have_prev_shear_ = false;
+
+  // --- kAuto detector (Calibration fields of the same names).
+  double relax_rate_on_ = 0.0;
+  int on_frames_ = 1;
+  double min_shift_m_ = 0.0;
+  double exit_fraction_ = 0.0;
+  double rest_speed_ = 0.0;
+  double confirm_s_ = 0.0;
+  int catchup_frames_ = 1;
+  bool slipping_ = false;
+  int evidence_frames_ = 0;
+  double rest_s_ = 0.0;
+  double peak_shift_m_ = 0.0;
+  int catchup_left_ = 0;
+  GridArray<std::int32_t> deficit_x_;  // Q16 shear units (displacement-proxy reading)
+  GridArray<std::int32_t> deficit_y_;
+  Eigen::Vector2d deficit_t_ = Eigen::Vector2d::Zero();  // translation deficit (m)
+  double smoothing_s_ = 0.0;
+  Eigen::Vector3d content_ = Eigen::Vector3d::Zero();  // smoothed X
+  bool have_content_ = false;
+  void reset_detector() noexcept;
 };
 
 }  // namespace tacse3::dsp

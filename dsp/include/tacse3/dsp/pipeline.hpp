@@ -37,17 +37,17 @@ Status validate(const PipelineConfig& config) noexcept;
 // Every intermediate field of one sensor's last frame (for tests, tools and --dump-fields).
 struct SensorFields {
   WorkImage work{};
-  VectorField flow{};        // block flow w vs the undeformed reference, Q16 working px
+  VectorField flow{};  // block flow w vs the undeformed reference, Q16 working px
   GridMask flow_valid{};
-  VectorField smoothed{};    // Gaussian-smoothed w, Q16 working px
+  VectorField smoothed{};  // Gaussian-smoothed w, Q16 working px
   GridMask smoothed_valid{};
-  ScalarField density{};     // 𝒢, Q16 (0 = undeformed, < 0 = local expansion)
-  VectorField d{};           // NHHD curl-free part
-  VectorField r{};           // NHHD divergence-free part
-  VectorField k{};           // NHHD harmonic part
-  ScalarField fz{};          // normal response f^z, Q16
-  VectorField shear{};       // calibrated shear (f^x, f^y), Q16 shear units
-  ContactSet contact{};      // Ω and the 3D contact points
+  ScalarField density{};  // 𝒢, Q16 (0 = undeformed, < 0 = local expansion)
+  VectorField d{};        // NHHD curl-free part
+  VectorField r{};        // NHHD divergence-free part
+  VectorField k{};        // NHHD harmonic part
+  ScalarField fz{};       // normal response f^z, Q16
+  VectorField shear{};    // calibrated shear (f^x, f^y), Q16 shear units
+  ContactSet contact{};   // Ω and the 3D contact points
 };
 
 // Result of one sensor's frame.
@@ -58,7 +58,9 @@ struct SensorResult {
   bool reference_taken = false;  // this frame became the (tare) reference
   int tracked_points = 0;        // valid block-flow points
   std::uint32_t keyframe_switches = 0;
-  SensorMotion motion{};         // per-sensor translation, moments and own-frame ω
+  SensorMotion motion{};  // per-sensor translation, moments and own-frame ω
+  // kAuto: the stick/slip detector's decision this frame (velocity proxy used); false otherwise.
+  bool slipping = false;
 };
 
 // One sensor: frame → luma → block flow → smoothing → 𝒢 → NHHD → forces → Ω, q → motion.
@@ -109,7 +111,7 @@ class SensorPipeline {
 struct DualConfig {
   PipelineConfig pipeline{};
   FusionConfig fusion{};
-  double finger_separation_m = 0.040;   // distance W between the gel surfaces, [0, 0.5]
+  double finger_separation_m = 0.040;  // distance W between the gel surfaces, [0, 0.5]
   double nominal_frame_period_s = 1.0 / 120.0;
   // A gap longer than this between frames restarts the motion state instead of differentiating
   // across it (the sensor stalled or was lost). (0, 1].
@@ -126,12 +128,13 @@ struct DualResult {
   std::int64_t t_ns = 0;
   std::array<SensorResult, 2> sensors{};  // [left, right]
   std::array<bool, 2> present{false, false};
-  FusedMotion fused{};                    // this frame's fused twist (before averaging)
-  Vector6d twist = Vector6d::Zero();      // moving-averaged twist ξ̄ in G, [ω rad/s; v m/s]
-  Pose pose{};                            // integrated object pose in G since tare/reset
-  bool valid = false;                     // fused.valid for this frame
-  bool single_sensor = false;             // only one sensor contributed
-  double dt_s = 0.0;                      // integration step used
+  FusedMotion fused{};                         // this frame's fused twist (before averaging)
+  Vector6d twist = Vector6d::Zero();           // moving-averaged twist ξ̄ in G, [ω rad/s; v m/s]
+  Pose pose{};                                 // integrated object pose in G since tare/reset
+  bool valid = false;                          // fused.valid for this frame
+  bool single_sensor = false;                  // only one sensor contributed
+  double dt_s = 0.0;                           // integration step used
+  std::array<bool, 2> slipping{false, false};  // per sensor, = sensors[k].slipping
 };
 
 // Two sensors, fusion (paper sign matrix or joint solve), moving average and SE(3) integration.

@@ -46,6 +46,13 @@ struct SensorMotionRef {
   int translation_source = 0;                       // as dsp::TranslationSource
   Eigen::Vector3d omega = Eigen::Vector3d::Zero();  // scaled, own-frame stacked LS
   bool proxy_valid = false;
+  // kAuto detector, as dsp::SensorMotion.
+  bool slipping = false;
+  bool slip_onset = false;
+  bool stick_confirmed = false;
+  double slip_relax_rate = 0.0;
+  double shear_shift_m = 0.0;
+  double shear_rate_m_s = 0.0;
 };
 
 // Same rules as dsp::MotionEstimator (translation sources, proxy modes, λ), in double.
@@ -63,6 +70,17 @@ class MotionRef {
   std::vector<Eigen::Vector3d> prev_q_;
   std::vector<double> prev_sx_, prev_sy_;
   bool have_prev_shear_ = false;
+  // kAuto detector state (dsp::MotionEstimator's, in double).
+  bool slipping_ = false;
+  int evidence_frames_ = 0;
+  double rest_s_ = 0.0;
+  double peak_shift_m_ = 0.0;
+  int catchup_left_ = 0;
+  std::vector<double> deficit_x_, deficit_y_;  // shear units
+  Eigen::Vector2d deficit_t_ = Eigen::Vector2d::Zero();
+  Eigen::Vector3d content_ = Eigen::Vector3d::Zero();
+  bool have_content_ = false;
+  void reset_detector();
 };
 
 // --- Analytic scene for tests and benchmarks: one pad touching an object that moves rigidly.

@@ -45,6 +45,8 @@ struct CalibrateReport {
   std::array<int, 2> recordings_per_mode{0, 0};      // [velocity, displacement]
   int iterations = 0;
   std::vector<std::string> notes;  // sanity bounds hit, parts not fitted
+  // Summed relative final-pose cost of each kAuto onset-threshold candidate (calibrate.cpp).
+  std::vector<double> detector_cost;
 };
 
 // Runs the pipeline over every source in three stages (τ from the f^z noise; the shear gains,

@@ -1,0 +1,284 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tests: VelocityProxy::kAuto: planar rigid content, stick/slip decisions, deficit payback.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include "tacse3/dsp/calibration.hpp"
+#include "tacse3/dsp/motion.hpp"
+#include "tacse3/dsp_ref/motion_ref.hpp"
+
+namespace tacse3::dsp {
+namespace {
+
+constexpr double kDt = 1.0 / 120.0;
+constexpr double kPitchM = 0.6e-3;  // flow-grid spacing on the pad (8 sensor px of 0.075 mm)
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A disc of grid cells (radius 6 cells) around the grid centre, 0.5 mm deep, as a ContactSet and
+// as the reference's ContactSetRef (same points).
+struct Disc {
+  std::unique_ptr<ContactSet> cs = std::make_unique<ContactSet>();
+  dsp_ref::ContactSetRef ref;
+  Disc() {
+    const auto n = static_cast<std::size_t>(kGridCount);
+    ref.mask.assign(n, 0);
+    ref.fz_filtered.assign(n, 0.0);
+    ref.q.assign(n, Eigen::Vector3d::Zero());
+    for (int gy = 0; gy < kGridHeight; ++gy) {
+      for (int gx = 0; gx < kGridWidth; ++gx) {
+        const double x = (gx - kGridWidth / 2 + 0.5) * kPitchM;
+        const double y = (gy - kGridHeight / 2 + 0.5) * kPitchM;
+        if (std::hypot(x, y) > 6.0 * kPitchM) continue;
+        const auto i = static_cast<std::size_t>(gy * kGridWidth + gx);
+        const auto xn = static_cast<std::int32_t>(std::lround(x * 1e9));
+        const auto yn = static_cast<std::int32_t>(std::lround(y * 1e9));
+        cs->mask.v[i] = 1;
+        cs->x_nm.v[i] = xn;
+        cs->y_nm.v[i] = yn;
+        cs->z_nm.v[i] = 500000;
+        ++cs->count;
+        ref.mask[i] = 1;
+        ref.q[i] = Eigen::Vector3d(xn * 1e-9, yn * 1e-9, 0.5e-3);
+        ++ref.count;
+      }
+    }
+    cs->contact = true;
+  }
+  // Shear (shear units) of a rotation by theta about the pad normal plus a shift (m), read as a
+  // contact displacement with c_displacement.
+  void shear(double theta, double tx, double c_disp, VectorField& out, std::vector<double>& sx,
+             std::vector<double>& sy) const {
+    out.x.fill(0);
+    out.y.fill(0);
+    sx.assign(static_cast<std::size_t>(kGridCount), 0.0);
+    sy.assign(static_cast<std::size_t>(kGridCount), 0.0);
+    for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+      if (cs->mask.v[i] == 0) continue;
+      const double x = cs->x_nm.v[i] * 1e-9, y = cs->y_nm.v[i] * 1e-9;
+      const double ux = (-theta * y + tx) / c_disp, uy = theta * x / c_disp;
+      out.x.v[i] = static_cast<std::int32_t>(std::lround(ux * 65536.0));
+      out.y.v[i] = static_cast<std::int32_t>(std::lround(uy * 65536.0));
+      sx[i] = out.x.v[i] / 65536.0;
+      sy[i] = out.y.v[i] / 65536.0;
+    }
+  }
+};
+
+// Minimum-jerk position and its rate on [0, 1].
+double min_jerk(double s) {
+  s = std::clamp(s, 0.0, 1.0);
+  return s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+}
+double min_jerk_rate(double s) {
+  if (s <= 0.0 || s >= 1.0) return 0.0;
+  return 30.0 * s * s * (1.0 - s) * (1.0 - s);
+}
+
+// The gel's drag time (shear displacement per unit sliding speed) of the simulator, 50 ms:
+// c_velocity = c_displacement / drag.
+constexpr double kDragS = 0.05;
+Calibration base_cal() {
+  Calibration c;
+  c.c_velocity = c.c_displacement / kDragS;
+  return c;
+}
+Calibration auto_cal() {
+  Calibration c = base_cal();
+  c.velocity_proxy = VelocityProxy::kAuto;
+  return c;
+}
+
+TEST(SlipDetector, ValidateAcceptsAutoAndRejectsBadThresholds) {
+  Calibration c = auto_cal();
+  EXPECT_EQ(validate(c), Status::kOk);
+  c.slip_relax_rate_on = 0.0;
+  EXPECT_EQ(validate(c), Status::kBadCalibration);
+  c = auto_cal();
+  c.slip_on_frames = 0;
+  EXPECT_EQ(validate(c), Status::kBadCalibration);
+  c = auto_cal();
+  c.slip_exit_fraction = 1.5;
+  EXPECT_EQ(validate(c), Status::kBadCalibration);
+  c = auto_cal();
+  c.stick_rest_speed_m_s = std::nan("");
+  EXPECT_EQ(validate(c), Status::kBadCalibration);
+  c = auto_cal();
+  c.slip_catchup_frames = 0;
+  EXPECT_EQ(validate(c), Status::kBadCalibration);
+  c = auto_cal();
+  c.slip_smoothing_s = -0.01;
+  EXPECT_EQ(validate(c), Status::kBadCalibration);
+  c = auto_cal();
+  c.velocity_proxy = static_cast<VelocityProxy>(3);
+  EXPECT_EQ(validate(c), Status::kBadCalibration);
+}
+
+TEST(SlipDetector, PlanarContentOfARigidShearIsItsRotationAndShift) {
+  const Disc disc;
+  const Calibration cal;
+  VectorField sh;
+  std::vector<double> sx, sy;
+  const double theta = 2.0 * kDeg, tx = 40e-6;
+  disc.shear(theta, tx, cal.c_displacement, sh, sx, sy);
+  ContactMoments m;
+  double inertia = 0.0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+    if (disc.cs->mask.v[i] == 0) continue;
+    const std::int64_t x = disc.cs->x_nm.v[i], y = disc.cs->y_nm.v[i];
+    ++m.n;
+    m.sx += x;
+    m.sy += y;
+    m.sxx += x * x;
+    m.syy += y * y;
+    m.svx += sh.x.v[i];
+    m.svy += sh.y.v[i];
+    m.sx_vy += x * sh.y.v[i];
+    m.sy_vx += y * sh.x.v[i];
+    inertia += (x * 1e-9) * (x * 1e-9) + (y * 1e-9) * (y * 1e-9);
+  }
+  const Eigen::Vector3d X = planar_content(m, cal.c_displacement / 65536.0);
+  const double lever = std::sqrt(inertia / static_cast<double>(m.n));
+  // Q16 rounding of the shear: 1/65536 shear unit = 2.3 nm.
+  EXPECT_NEAR(X(0), lever * theta, 1e-8);
+  EXPECT_NEAR(X(1), tx, 1e-8);
+  EXPECT_NEAR(X(2), 0.0, 1e-8);
+  EXPECT_EQ(planar_content(ContactMoments{}, 1.0), Eigen::Vector3d::Zero());
+}
+
+// Runs one auto and one fixed-mode estimator (and the reference's auto) over a shear history.
+struct Trace {
+  std::vector<Eigen::Vector3d> omega_auto, omega_fixed, omega_ref;
+  std::vector<bool> slipping, slipping_ref;
+  int onsets = 0;
+};
+
+Trace run(const std::vector<double>& theta, VelocityProxy fixed_mode) {
+  const Disc disc;
+  const Calibration cal_auto = auto_cal();
+  Calibration cal_fixed = base_cal();
+  cal_fixed.velocity_proxy = fixed_mode;
+  auto a = std::make_unique<MotionEstimator>();
+  auto f = std::make_unique<MotionEstimator>();
+  EXPECT_EQ(a->configure(cal_auto), Status::kOk);
+  EXPECT_EQ(f->configure(cal_fixed), Status::kOk);
+  dsp_ref::MotionRef ref(cal_auto);
+  Trace t;
+  auto sh = std::make_unique<VectorField>();
+  std::vector<double> sx, sy;
+  for (const double th : theta) {
+    disc.shear(th, 0.0, cal_auto.c_displacement, *sh, sx, sy);
+    SensorMotion ma, mf;
+    EXPECT_EQ(a->update(*disc.cs, *sh, kDt, ma), Status::kOk);
+    EXPECT_EQ(f->update(*disc.cs, *sh, kDt, mf), Status::kOk);
+    const dsp_ref::SensorMotionRef mr = ref.update(disc.ref, sx, sy, kDt);
+    t.omega_auto.push_back(ma.omega);
+    t.omega_fixed.push_back(mf.omega);
+    t.omega_ref.push_back(mr.omega);
+    t.slipping.push_back(ma.slipping);
+    t.slipping_ref.push_back(mr.slipping);
+    t.onsets += ma.slip_onset ? 1 : 0;
+  }
+  return t;
+}
+
+double integrate_z(const std::vector<Eigen::Vector3d>& w) {
+  double s = 0.0;
+  for (const auto& v : w) s += v.z() * kDt;
+  return s;
+}
+
+TEST(SlipDetector, StickRampAndHoldStaysStuckAndEqualsTheDisplacementProxy) {
+  // A 4° stick rotation over 0.5 s, then a 1 s hold: the shear is the accumulated displacement.
+  std::vector<double> theta;
+  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
+  for (int k = 0; k <= 60; ++k) theta.push_back(4.0 * kDeg * min_jerk(k / 60.0));
+  for (int k = 0; k < 120; ++k) theta.push_back(4.0 * kDeg);
+  const Trace t = run(theta, VelocityProxy::kDisplacement);
+  EXPECT_EQ(t.onsets, 0);
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    ASSERT_FALSE(t.slipping[k]) << "frame " << k;
+    ASSERT_FALSE(t.slipping_ref[k]) << "frame " << k;
+    // Same proxy, same moments: bit-identical.
+    ASSERT_EQ(t.omega_auto[k], t.omega_fixed[k]) << "frame " << k;
+  }
+  EXPECT_NEAR(integrate_z(t.omega_auto), 4.0 * kDeg, 0.02 * kDeg);
+  EXPECT_NEAR(integrate_z(t.omega_ref), 4.0 * kDeg, 0.02 * kDeg);
+}
+
+TEST(SlipDetector, SlideIsDetectedWhenTheShearRelaxesAndThePoseCatchesUp) {
+  // A slide: the shear follows the sliding speed (gel lag ignored), rising and falling with a
+  // minimum-jerk speed profile of a 30° rotation over 1 s, then 0.5 s at rest. The velocity
+  // proxy with c_velocity = c_displacement / drag reads it exactly.
+  const Calibration cal = auto_cal();
+  const double drag_s = kDragS;
+  std::vector<double> theta;
+  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
+  for (int k = 0; k <= 120; ++k) {
+    theta.push_back(drag_s * 30.0 * kDeg * min_jerk_rate(k / 120.0) / 1.0);
+  }
+  for (int k = 0; k < 60; ++k) theta.push_back(0.0);
+  const Trace t = run(theta, VelocityProxy::kVelocity);
+  EXPECT_EQ(t.onsets, 1);
+  // Detected in the second half of the slide (the shear relaxes as the slide slows) ...
+  std::size_t first = theta.size();
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    if (t.slipping[k]) {
+      first = k;
+      break;
+    }
+  }
+  EXPECT_GT(first, 24u + 60u);
+  EXPECT_LT(first, 24u + 120u);
+  // ... and back to stick once the shear has relaxed at rest.
+  EXPECT_FALSE(t.slipping.back());
+  // The payback makes the integrated rotation the velocity proxy's (30°), not the displacement
+  // proxy's (0°), without a pose jump: no frame turns faster than the slide's peak rate plus
+  // the payback spread over slip_catchup_frames.
+  const double v_total = integrate_z(t.omega_fixed);
+  EXPECT_NEAR(v_total, 30.0 * kDeg, 0.3 * kDeg);
+  EXPECT_NEAR(integrate_z(t.omega_auto), v_total, 0.01 * v_total);
+  EXPECT_NEAR(integrate_z(t.omega_ref), v_total, 0.01 * v_total);
+  double peak_fixed = 0.0, peak_auto = 0.0;
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    peak_fixed = std::max(peak_fixed, std::abs(t.omega_fixed[k].z()));
+    peak_auto = std::max(peak_auto, std::abs(t.omega_auto[k].z()));
+  }
+  const double payback_rate = v_total / (cal.slip_catchup_frames * kDt);
+  EXPECT_LT(peak_auto, peak_fixed + payback_rate);
+  // Fixed point and the double reference take the same decisions and agree per frame.
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    ASSERT_EQ(t.slipping[k], t.slipping_ref[k]) << "frame " << k;
+    ASSERT_NEAR(t.omega_auto[k].z(), t.omega_ref[k].z(), 1e-3 + 1e-3 * std::abs(t.omega_ref[k].z()))
+        << "frame " << k;
+  }
+}
+
+TEST(SlipDetector, ContactLossRestartsSticking) {
+  const Disc disc;
+  auto me = std::make_unique<MotionEstimator>();
+  ASSERT_EQ(me->configure(auto_cal()), Status::kOk);
+  auto sh = std::make_unique<VectorField>();
+  std::vector<double> sx, sy;
+  bool slipped = false;
+  for (int k = 0; k <= 120; ++k) {
+    disc.shear(kDragS * 30.0 * kDeg * min_jerk_rate(k / 120.0), 0.0, auto_cal().c_displacement, *sh,
+               sx, sy);
+    SensorMotion m;
+    ASSERT_EQ(me->update(*disc.cs, *sh, kDt, m), Status::kOk);
+    slipped = slipped || m.slipping;
+  }
+  EXPECT_TRUE(slipped);
+  auto empty = std::make_unique<ContactSet>();
+  SensorMotion m;
+  ASSERT_EQ(me->update(*empty, *sh, kDt, m), Status::kOk);
+  EXPECT_FALSE(m.contact);
+  ASSERT_EQ(me->update(*disc.cs, *sh, kDt, m), Status::kOk);
+  EXPECT_FALSE(m.slipping);
+}
+
+}  // namespace
+}  // namespace tacse3::dsp
