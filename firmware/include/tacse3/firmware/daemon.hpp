@@ -1,0 +1,118 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: the daemon: cameras, capture/DSP/RX threads, housekeeping, signals, shutdown.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "tacse3/config/calibration_file.hpp"
+#include "tacse3/firmware/board.hpp"
+#include "tacse3/firmware/cli.hpp"
+#include "tacse3/firmware/engine.hpp"
+#include "tacse3/hal/can/channel.hpp"
+
+namespace tacse3::hal {
+class SimRig;
+class SimCamera;
+class GpioBackend;
+class GpioController;
+}  // namespace tacse3::hal
+
+namespace tacse3::firmware {
+
+// Where the calibration came from: built-in defaults or a file (reloaded on SIGHUP).
+struct CalibrationSource {
+  std::filesystem::path file;  // empty: built-in defaults
+  config::CalibrationSet set;
+};
+
+// Loads --calibration (or the defaults) and checks it against the board's pipeline settings.
+bool load_calibration_source(const std::string& file, CalibrationSource* out, std::string* error);
+
+// The pipeline configuration of a board + calibration (what --check validates).
+bool make_pipeline_config(const BoardConfig& board, const CalibrationSource& cal,
+                          dsp::DualConfig* dual, std::array<dsp::Calibration, 2>* sensors,
+                          std::string* error);
+
+struct DaemonSummary {
+  EngineStats engine;
+  protocol::Cycle last_cycle;  // the last cycle as sent (quantised)
+  std::int64_t latency_p50_us = -1;
+  std::int64_t latency_p99_us = -1;
+  std::int64_t dsp_p50_us = -1;
+  double streaming_s = 0.0;
+  bool have_truth = false;
+  double truth_rotation_deg[3] = {0, 0, 0};  // sim board: truth rotation vector at the last cycle
+  double estimated_rotation_deg[3] = {0, 0, 0};
+  double rotation_error_deg = 0.0;
+};
+
+class Daemon {
+ public:
+  // Opens every device of the board (cameras, CAN channel, GPIO). Diagnostics go to `log`.
+  static std::unique_ptr<Daemon> create(const BoardConfig& board, const Options& options,
+                                        const CalibrationSource& calibration, std::FILE* log,
+                                        std::string* error);
+  ~Daemon();
+
+  // Runs until request_stop(), a handled signal (SIGTERM/SIGINT stop, SIGHUP reloads the
+  // calibration) or options.seconds of streaming. The caller blocks SIGTERM/SIGINT/SIGHUP in
+  // every thread first (handle_signals) so they are taken here with sigtimedwait.
+  int run(bool handle_signals);
+  void request_stop() noexcept { stop_.store(true, std::memory_order_release); }
+  // Reload the calibration file now (what SIGHUP does). false + message if the file is bad; the
+  // running calibration is kept.
+  bool reload_calibration(std::string* message);
+
+  // Test access.
+  hal::SimCamera* sim_camera(std::size_t sensor) noexcept;
+  const hal::SimRig* sim_rig() const noexcept { return rig_.get(); }
+  const SharedState& shared() const noexcept { return shared_; }
+  protocol::State state() const noexcept {
+    return static_cast<protocol::State>(shared_.state.load(std::memory_order_relaxed));
+  }
+  const DaemonSummary& summary() const noexcept { return summary_; }
+
+ private:
+  Daemon() = default;
+  void capture_loop(std::size_t s);
+  void dsp_loop();
+  void rx_loop();
+  void housekeeping_tick(std::int64_t now_ns, bool handle_signals);
+  void finish_summary();
+  void say(int level, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
+
+  BoardConfig board_;
+  Options options_;
+  CalibrationSource calibration_;
+  std::FILE* log_ = stderr;
+
+  std::shared_ptr<hal::SimRig> rig_;
+  std::array<std::unique_ptr<hal::Camera>, 2> cameras_;
+  std::array<hal::SimCamera*, 2> sim_cameras_{};
+  std::unique_ptr<hal::can::Channel> channel_;
+  std::unique_ptr<hal::GpioBackend> gpio_;
+  std::unique_ptr<hal::GpioController> gpio_controller_;
+  std::unique_ptr<dsp::DualPipeline> pipeline_;
+  std::unique_ptr<std::array<FrameRing, 2>> rings_;
+  std::unique_ptr<std::array<CommandRing, 2>> command_rings_;  // [0] CAN RX, [1] local
+  std::unique_ptr<Engine> engine_;
+  SharedState shared_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> dsp_ready_{false};
+  std::int64_t streaming_since_ns_ = 0;
+  bool ready_sent_ = false;
+  std::uint64_t last_heartbeat_ = 0;
+  std::int64_t next_watchdog_ns_ = 0;
+  long long watchdog_usec_ = 0;
+  std::uint32_t tare_count_ = 0;
+  std::uint8_t last_state_ = 0xFF;
+  std::int64_t next_verbose_ns_ = 0;
+  DaemonSummary summary_;
+};
+
+}  // namespace tacse3::firmware

@@ -1,0 +1,164 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: the DSP thread's loop body: pair frames, run the pipeline, apply commands,
+// emit cycles, status and acks on the CAN channel. No heap, no locks, no blocking per frame.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+#include "tacse3/dsp/pipeline.hpp"
+#include "tacse3/firmware/health.hpp"
+#include "tacse3/firmware/latency.hpp"
+#include "tacse3/firmware/pairing.hpp"
+#include "tacse3/hal/camera.hpp"
+#include "tacse3/hal/camera/spsc_ring.hpp"
+#include "tacse3/hal/can/channel.hpp"
+#include "tacse3/protocol/codec.hpp"
+#include "tacse3/protocol/commands.hpp"
+
+namespace tacse3::firmware {
+
+// Capture thread -> DSP thread. 8 frames = 66 ms at 120 Hz, more than the camera has buffers,
+// so the ring never holds the camera back in normal operation.
+using FrameRing = hal::SpscRing<hal::Frame, 8>;
+// RX thread / housekeeping -> DSP thread: validated commands (or NACK reasons) to answer.
+using CommandRing = hal::SpscRing<protocol::CommandResult, 16>;
+
+// State shared between the threads: plain atomics, written by one side, read by the other.
+struct SharedState {
+  struct Sensor {
+    std::atomic<bool> disconnected{false};       // capture thread: the camera reported a loss
+    std::atomic<std::uint64_t> camera_drops{0};  // capture thread: sequence gaps + ring overflow
+    std::atomic<std::uint64_t> frames{0};        // capture thread: frames handed to the ring
+  };
+  std::array<Sensor, 2> sensors{};
+  std::atomic<std::uint64_t> heartbeat{0};      // DSP thread: +1 per loop iteration
+  std::atomic<std::uint8_t> state{0};           // DSP thread: protocol::State
+  std::atomic<std::uint64_t> cycles{0};         // DSP thread: processed samples
+  std::atomic<std::uint64_t> emitted{0};        // DSP thread: cycles sent
+  std::atomic<std::uint32_t> tare_requests{0};  // housekeeping: tare button presses (cumulative)
+  std::atomic<std::uint32_t> rejected_commands{0};  // RX thread: CommandStats::rejected()
+  std::atomic<std::uint64_t> can_tx_dropped{0};     // housekeeping: channel stats
+  std::atomic<bool> can_error_passive{false};       // housekeeping: channel stats
+  // Calibration reload (SIGHUP): housekeeping fills `calibration` while flag == kIdle and sets
+  // kPending; the DSP thread applies it between cycles and answers kApplied / kRejected.
+  enum : int { kIdle = 0, kPending = 1, kApplied = 2, kRejected = 3 };
+  std::atomic<int> calibration_flag{kIdle};
+  std::array<dsp::Calibration, 2> calibration{};
+  std::atomic<bool> calibration_invalid{false};  // the last reload failed (status fault code)
+};
+
+struct EngineConfig {
+  protocol::TxConfig tx{};
+  PairingConfig pairing{};
+  HealthConfig health{};
+  std::array<bool, 2> configured{true, true};
+  std::uint8_t rate_divider = 1;
+  bool stream_enabled = true;
+  protocol::VelocityMode velocity_mode = protocol::VelocityMode::kAuto;
+  std::int64_t status_period_ns = 100'000'000;  // 10 Hz
+};
+
+struct EngineStats {
+  std::uint64_t samples = 0;         // processed frame pairs / single frames
+  std::uint64_t pairs = 0;           // both sensors
+  std::uint64_t singles = 0;         // one sensor alone
+  std::uint64_t dropped_late = 0;    // heads older than the last sample
+  std::uint64_t cycles_sent = 0;     // cycles encoded and handed to the channel
+  std::uint64_t send_failures = 0;   // Channel::send returned false
+  std::uint64_t status_groups = 0;   // periodic status emissions
+  std::uint64_t status_changes = 0;  // change-triggered Status frames
+  std::uint64_t commands = 0;        // commands answered
+  // Sample time from the last frame pair to the sample at which the state last became
+  // DEGRADED_SINGLE_SENSOR (-1: never): how many frame periods a lost sensor went unnoticed.
+  std::int64_t degraded_after_pair_ns = -1;
+};
+
+class Engine {
+ public:
+  // The pipeline must be configured; cameras may be null (no such sensor / tests without one).
+  Engine(const EngineConfig& config, dsp::DualPipeline& pipeline, hal::can::Channel& channel,
+         std::array<hal::Camera*, 2> cameras, std::array<FrameRing*, 2> rings,
+         std::array<CommandRing*, 2> command_rings, SharedState& shared) noexcept;
+
+  void start(std::int64_t now_ns) noexcept;
+  // One loop iteration at now_ns (CLOCK_MONOTONIC). Returns true when it did work (the caller
+  // sleeps briefly when it did not).
+  bool step(std::int64_t now_ns) noexcept;
+  // Hands every frame still held back to its camera (before the cameras stop).
+  void release_all() noexcept;
+
+  const EngineStats& stats() const noexcept { return stats_; }
+  const StateOutput& state() const noexcept { return state_; }
+  const protocol::Cycle& last_cycle() const noexcept { return last_cycle_; }  // as sent
+  const dsp::DualResult& last_result() const noexcept { return result_; }
+  std::int64_t latency_percentile_us(double p) const noexcept { return latency_.percentile(p); }
+  std::int64_t dsp_time_percentile_us(double p) const noexcept { return dsp_time_.percentile(p); }
+  std::uint8_t rate_divider() const noexcept { return rate_divider_; }
+  bool stream_enabled() const noexcept { return stream_enabled_; }
+  protocol::VelocityMode velocity_mode() const noexcept { return velocity_mode_; }
+
+ private:
+  struct Head {
+    PendingFrame pending;
+    hal::Frame frame;
+  };
+  void refill_heads(std::int64_t now_ns) noexcept;
+  void release_head(std::size_t s) noexcept;
+  void process(bool use_left, bool use_right, std::int64_t now_ns) noexcept;
+  void handle_command(const protocol::CommandResult& r) noexcept;
+  bool apply(const protocol::Command& c) noexcept;
+  void apply_pending_calibration() noexcept;
+  void update_state(std::int64_t now_ns) noexcept;
+  protocol::StatusMsg status_message() const noexcept;
+  void send_status_group() noexcept;
+  void send_status_change() noexcept;
+  bool send(const protocol::CanFrame& f) noexcept;
+
+  EngineConfig config_;
+  dsp::DualPipeline& pipeline_;
+  hal::can::Channel& channel_;
+  std::array<hal::Camera*, 2> cameras_;
+  std::array<FrameRing*, 2> rings_;
+  std::array<CommandRing*, 2> command_rings_;
+  SharedState& shared_;
+
+  std::array<Head, 2> heads_{};
+  std::array<SensorObservation, 2> observed_{};
+  std::array<std::uint64_t, 2> pairing_drops_{};
+  StateMachine machine_;
+  StateOutput state_{};
+  dsp::DualResult result_{};
+  protocol::CycleFrames cycle_frames_{};
+  protocol::Cycle last_cycle_{};
+  std::array<dsp::Calibration, 2> base_calibration_{};
+  TimingWindow<> latency_;
+  TimingWindow<> dsp_time_;
+  std::int64_t last_t_ns_ = INT64_MIN;
+  std::int64_t last_pair_t_ns_ = INT64_MIN;
+  std::int64_t next_status_ns_ = 0;
+  std::uint64_t sample_index_ = 0;
+  std::uint8_t cycle_counter_ = 0;
+  std::uint8_t status_counter_ = 0;
+  std::uint8_t rate_divider_ = 1;
+  bool stream_enabled_ = true;
+  bool pose_reset_pending_ = false;
+  bool status_sent_this_cycle_ = false;
+  bool status_dirty_ = false;
+  bool have_result_ = false;
+  std::uint32_t tare_seen_ = 0;
+  protocol::VelocityMode velocity_mode_ = protocol::VelocityMode::kAuto;
+  std::array<bool, 2> contact_{};
+  std::array<bool, 2> slip_{};
+  EngineStats stats_{};
+};
+
+// The dsp proxy a protocol mode maps to: AUTO is the pipeline's own kAuto when dsp has one,
+// else the calibration's own proxy (`calibrated`).
+dsp::VelocityProxy to_dsp_proxy(protocol::VelocityMode m, dsp::VelocityProxy calibrated) noexcept;
+protocol::FusionMethod to_protocol(dsp::FusionMethod m) noexcept;
+dsp::FusionMethod to_dsp(protocol::FusionMethod m) noexcept;
+
+}  // namespace tacse3::firmware

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3d: the gripper firmware daemon (docs/firmware.md).
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <system_error>
+
+#include "tacse3/firmware/board.hpp"
+#include "tacse3/firmware/cli.hpp"
+#include "tacse3/firmware/daemon.hpp"
+
+namespace {
+
+using namespace tacse3;
+
+std::filesystem::path exe_dir() {
+  std::error_code ec;
+  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : p.parent_path();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  firmware::Options opt;
+  std::string error;
+  if (!firmware::parse_cli(argc, argv, &opt, &error)) {
+    std::fprintf(stderr, "tacse3d: %s\n%s", error.c_str(), firmware::usage_text());
+    return 2;
+  }
+  if (opt.help) {
+    std::fputs(firmware::usage_text(), stdout);
+    return 0;
+  }
+
+  const std::filesystem::path board_file =
+      firmware::resolve_board(opt.board, exe_dir(), TACSE3_SOURCE_BOARDS_DIR, &error);
+  if (board_file.empty()) {
+    std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
+    return 1;
+  }
+  firmware::BoardConfig board;
+  if (!firmware::load_board(board_file, &board, &error)) {
+    std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
+    return 1;
+  }
+  if (!opt.can_log.empty()) {
+    board.can.backend = firmware::CanBackend::kLog;
+    board.can.log = opt.can_log;
+  }
+  if (!opt.can_iface.empty()) board.can.interface = opt.can_iface;
+
+  firmware::CalibrationSource cal;
+  if (!firmware::load_calibration_source(opt.calibration, &cal, &error)) {
+    std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
+    return 1;
+  }
+  dsp::DualConfig dual;
+  std::array<dsp::Calibration, 2> sensors;
+  if (!firmware::make_pipeline_config(board, cal, &dual, &sensors, &error)) {
+    std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
+    return 1;
+  }
+  if (opt.check) {
+    std::fputs(firmware::describe(board).c_str(), stdout);
+    std::printf("  calibration: %s\n", cal.file.empty() ? "built-in defaults" : cal.file.c_str());
+    std::printf("ok\n");
+    return 0;
+  }
+  if (!opt.record_dir.empty()) {
+    std::fprintf(stderr,
+                 "tacse3d: --record %s: the streaming recording writer is not in this build; "
+                 "streaming without recording\n",
+                 opt.record_dir.c_str());
+  }
+
+  // Signals are taken synchronously by the housekeeping loop (sigtimedwait), so they are blocked
+  // in every thread, which inherit this mask. A closed stdout (the reader went away) must not
+  // kill the daemon: the write fails and is counted instead.
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  auto daemon = firmware::Daemon::create(board, opt, cal, stderr, &error);
+  if (!daemon) {
+    std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
+    return 1;
+  }
+  if (opt.verbosity > 0) {
+    std::fprintf(stderr, "tacse3d: board %s (%s), calibration %s, CAN %s\n", board.name.c_str(),
+                 board_file.c_str(), cal.file.empty() ? "built-in" : cal.file.c_str(),
+                 board.can.backend == firmware::CanBackend::kLog
+                     ? ("log " + board.can.log).c_str()
+                     : ("socketcan " + board.can.interface).c_str());
+  }
+  return daemon->run(true);
+}

@@ -1,0 +1,561 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: the daemon's threads, devices, housekeeping, signals and shutdown.
+#include "tacse3/firmware/daemon.hpp"
+
+#include <signal.h>
+#include <time.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <thread>
+
+#include "tacse3/dsp/se3.hpp"
+#include "tacse3/firmware/system.hpp"
+#include "tacse3/hal/camera/clock.hpp"
+#include "tacse3/hal/camera/sim_camera.hpp"
+#include "tacse3/hal/camera/v4l2_camera.hpp"
+#include "tacse3/hal/can/log_channel.hpp"
+#include "tacse3/hal/can/socketcan.hpp"
+#include "tacse3/hal/gpio.hpp"
+#include "tacse3/hal/gpio/controller.hpp"
+#include "tacse3/sim/simulator.hpp"
+#if TACSE3_HAVE_LIBCAMERA
+#include "tacse3/hal/camera/libcamera_camera.hpp"
+#endif
+
+namespace tacse3::firmware {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+constexpr int kCaptureTimeoutMs = 100;  // bounds how long a capture thread takes to see stop
+constexpr int kRxTimeoutMs = 100;
+constexpr std::int64_t kIdleSleepNs = 200'000;  // DSP loop with nothing to do (docs: latency)
+constexpr std::size_t kDspStackPrefault = 256 * 1024;
+
+hal::LedState led_state(protocol::State s) noexcept {
+  switch (s) {
+    case protocol::State::kBooting:
+      return hal::LedState::kBooting;
+    case protocol::State::kNoContact:
+      return hal::LedState::kNoContact;
+    case protocol::State::kTracking:
+      return hal::LedState::kTracking;
+    case protocol::State::kDegradedSingleSensor:
+      return hal::LedState::kDegraded;
+    case protocol::State::kFault:
+      return hal::LedState::kFault;
+  }
+  return hal::LedState::kFault;
+}
+
+void sleep_ns(std::int64_t ns) noexcept {
+  timespec ts{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+  nanosleep(&ts, nullptr);
+}
+
+}  // namespace
+
+bool load_calibration_source(const std::string& file, CalibrationSource* out, std::string* error) {
+  CalibrationSource c;
+  if (!file.empty()) {
+    c.file = file;
+    const config::Status st = config::load_calibration(file, &c.set);
+    if (!st) {
+      *error = st.message();
+      return false;
+    }
+  }
+  *out = std::move(c);
+  return true;
+}
+
+bool make_pipeline_config(const BoardConfig& board, const CalibrationSource& cal,
+                          dsp::DualConfig* dual, std::array<dsp::Calibration, 2>* sensors,
+                          std::string* error) {
+  dsp::DualConfig d;
+  d.finger_separation_m = board.pipeline.finger_separation_m;
+  d.fusion = fusion_config(board);
+  const int fps = board.sensors[0].enabled ? board.sensors[0].fps : board.sensors[1].fps;
+  d.nominal_frame_period_s = 1.0 / fps;
+  std::array<dsp::Calibration, 2> c = cal.set.for_method(board.pipeline.method);
+  for (auto& s : c)
+    s.velocity_proxy = to_dsp_proxy(board.pipeline.velocity_proxy, s.velocity_proxy);
+  if (dsp::validate(d) != dsp::Status::kOk) {
+    *error =
+        board.origin + ": [pipeline] / [sensors] rotation: the pipeline rejects this configuration";
+    return false;
+  }
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (dsp::validate(c[s]) != dsp::Status::kOk) {
+      *error = (cal.file.empty() ? std::string("built-in calibration") : cal.file.string()) + ": " +
+               (s == 0 ? "left" : "right") + " calibration rejected by the pipeline";
+      return false;
+    }
+  }
+  *dual = d;
+  *sensors = c;
+  return true;
+}
+
+void Daemon::say(int level, const char* fmt, ...) {
+  if (level > options_.verbosity || log_ == nullptr) return;
+  char buf[512];
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(buf, sizeof(buf), fmt, ap);
+  va_end(ap);
+  std::fprintf(log_, "tacse3d: %s\n", buf);
+  std::fflush(log_);
+}
+
+std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& options,
+                                       const CalibrationSource& calibration, std::FILE* log,
+                                       std::string* error) {
+  std::unique_ptr<Daemon> d(new Daemon());
+  d->board_ = board;
+  d->options_ = options;
+  d->calibration_ = calibration;
+  d->log_ = log;
+
+  // Pipeline: ~1.2 MB, allocated once here.
+  dsp::DualConfig dual;
+  std::array<dsp::Calibration, 2> cal;
+  if (!make_pipeline_config(board, calibration, &dual, &cal, error)) return nullptr;
+  d->pipeline_ = std::make_unique<dsp::DualPipeline>();
+  if (d->pipeline_->configure(dual, cal) != dsp::Status::kOk) {
+    *error = board.origin + ": the pipeline rejected the board/calibration configuration";
+    return nullptr;
+  }
+
+  // Cameras.
+  if (board.uses_backend(CameraBackend::kSim)) {
+    hal::SimRigConfig rc;
+    rc.scene.object = board.sim.object;
+    rc.scene.motion = board.sim.motion;
+    rc.scene.magnitude = board.sim.magnitude;
+    rc.scene.regime = board.sim.regime;
+    rc.scene.seed = board.sim.seed;
+    rc.scene.repeat = board.sim.repeat;
+    rc.scene.realtime = board.sim.realtime;
+    rc.scene.finger_separation_mm = board.pipeline.finger_separation_m * 1e3;
+    const auto& s0 = board.sensors[0].enabled ? board.sensors[0] : board.sensors[1];
+    rc.width = s0.width;
+    rc.height = s0.height;
+    rc.fps = s0.fps;
+    std::string e;
+    d->rig_ = hal::SimRig::create(rc, &e);
+    if (!d->rig_) {
+      *error = board.origin + ": " + e;
+      return nullptr;
+    }
+  }
+  for (std::size_t s = 0; s < 2; ++s) {
+    const SensorBoardConfig& sc = board.sensors[s];
+    if (!sc.enabled) continue;
+    const char* side = s == 0 ? "left" : "right";
+    hal::CameraConfig cc;
+    cc.device = sc.device;
+    cc.width = sc.width;
+    cc.height = sc.height;
+    cc.fps = sc.fps;
+    cc.buffer_count = sc.buffer_count;
+    cc.allow_mjpeg = sc.allow_mjpeg;
+    switch (sc.backend) {
+      case CameraBackend::kSim: {
+        hal::SimCameraConfig scc;
+        scc.sensor = s == 0 ? sim::Sensor::kLeft : sim::Sensor::kRight;
+        // Grey: what the sim calibration was fitted on, and the cheapest luma stage.
+        scc.format = dsp::PixelFormat::kGrey;
+        scc.buffer_count = sc.buffer_count;
+        auto cam = d->rig_->make_camera(scc);
+        d->sim_cameras_[s] = cam.get();
+        d->cameras_[s] = std::move(cam);
+        break;
+      }
+      case CameraBackend::kV4l2:
+        d->cameras_[s] = hal::make_v4l2_camera(cc);
+        break;
+      case CameraBackend::kLibcamera:
+#if TACSE3_HAVE_LIBCAMERA
+        d->cameras_[s] = hal::make_libcamera_camera(cc);
+        break;
+#else
+        *error = board.origin + ": sensors." + side +
+                 ".backend \"libcamera\": this tacse3d was built without libcamera";
+        return nullptr;
+#endif
+      case CameraBackend::kReplay:
+        *error = board.origin + ": sensors." + side +
+                 ".backend \"replay\": the replay camera backend is not in this build yet";
+        return nullptr;
+    }
+    const hal::CameraStatus st = d->cameras_[s]->open();
+    if (!st.ok()) {
+      *error = std::string("sensor ") + side + " (" + to_string(sc.backend) + " " + sc.device +
+               "): " + st.message();
+      return nullptr;
+    }
+  }
+
+  // CAN channel.
+  protocol::Endpoint ep;
+  ep.node_id = static_cast<std::uint8_t>(board.can.node_id);
+  ep.layout.mode =
+      board.can.extended_ids ? protocol::IdMode::kExtended : protocol::IdMode::kStandard;
+  if (!options.can_log.empty() || board.can.backend == CanBackend::kLog) {
+    const std::string out = !options.can_log.empty() ? options.can_log : board.can.log;
+    std::string e;
+    auto ch = hal::can::LogChannel::open(
+        "", out, e, board.can.interface.empty() ? "can0" : board.can.interface);
+    if (!ch) {
+      *error = "CAN log " + out + ": " + e;
+      return nullptr;
+    }
+    d->channel_ = std::move(ch);
+  } else {
+    hal::can::SocketCanOptions so;
+    so.fd = board.can.mode == protocol::FrameMode::kFd;
+    so.filters = hal::can::command_filters(ep);
+    so.tx_queue = static_cast<std::uint32_t>(board.can.tx_queue);
+    const std::string iface = options.can_iface.empty() ? board.can.interface : options.can_iface;
+    std::string e;
+    auto ch = hal::can::SocketCanChannel::open(iface, so, e);
+    if (!ch) {
+      *error = "CAN interface " + iface + ": " + e;
+      return nullptr;
+    }
+    d->channel_ = std::move(ch);
+  }
+
+  // GPIO.
+  d->gpio_ = board.gpio.backend == GpioBackendKind::kLibgpiod ? hal::make_libgpiod_gpio()
+                                                              : hal::make_null_gpio();
+  hal::GpioConfig gc = board.gpio.lines;
+  gc.consumer = "tacse3d";
+  if (const hal::GpioStatus st = d->gpio_->open(gc); !st.ok()) {
+    *error = board.origin + ": [gpio]: " + st.message();
+    return nullptr;
+  }
+  hal::GpioTiming timing;
+  timing.debounce_ns = static_cast<std::int64_t>(board.gpio.debounce_ms) * 1'000'000;
+  d->gpio_controller_ = std::make_unique<hal::GpioController>(*d->gpio_, timing);
+
+  // The engine.
+  d->rings_ = std::make_unique<std::array<FrameRing, 2>>();
+  d->command_rings_ = std::make_unique<std::array<CommandRing, 2>>();
+  EngineConfig ec;
+  ec.tx.endpoint = ep;
+  ec.tx.frame_mode = board.can.mode;
+  ec.pairing = pairing_config(board.pipeline.pair_tolerance_us, board.pipeline.stale_ms);
+  ec.health.stale_ns = static_cast<std::int64_t>(board.pipeline.stale_ms) * 1'000'000;
+  ec.health.lost_ns = static_cast<std::int64_t>(board.pipeline.lost_ms) * 1'000'000;
+  ec.configured = {board.sensors[0].enabled, board.sensors[1].enabled};
+  ec.rate_divider = static_cast<std::uint8_t>(board.can.rate_divider);
+  ec.velocity_mode = board.pipeline.velocity_proxy;
+  std::array<hal::Camera*, 2> cams{d->cameras_[0].get(), d->cameras_[1].get()};
+  std::array<FrameRing*, 2> rings{board.sensors[0].enabled ? &(*d->rings_)[0] : nullptr,
+                                  board.sensors[1].enabled ? &(*d->rings_)[1] : nullptr};
+  d->engine_ = std::make_unique<Engine>(
+      ec, *d->pipeline_, *d->channel_, cams, rings,
+      std::array<CommandRing*, 2>{&(*d->command_rings_)[0], &(*d->command_rings_)[1]}, d->shared_);
+  return d;
+}
+
+Daemon::~Daemon() {
+  for (auto& c : cameras_) {
+    if (c) c->stop();
+  }
+  if (gpio_) gpio_->close();
+}
+
+hal::SimCamera* Daemon::sim_camera(std::size_t sensor) noexcept {
+  return sensor < 2 ? sim_cameras_[sensor] : nullptr;
+}
+
+bool Daemon::reload_calibration(std::string* message) {
+  if (calibration_.file.empty()) {
+    *message = "SIGHUP: no --calibration file to reload (built-in defaults stay)";
+    return false;
+  }
+  CalibrationSource next;
+  std::string e;
+  if (!load_calibration_source(calibration_.file.string(), &next, &e)) {
+    *message = "calibration reload rejected, keeping the last good one: " + e;
+    shared_.calibration_invalid.store(true, std::memory_order_relaxed);
+    return false;
+  }
+  dsp::DualConfig dual;
+  std::array<dsp::Calibration, 2> cal;
+  if (!make_pipeline_config(board_, next, &dual, &cal, &e)) {
+    *message = "calibration reload rejected, keeping the last good one: " + e;
+    shared_.calibration_invalid.store(true, std::memory_order_relaxed);
+    return false;
+  }
+  // Hand it to the DSP thread (it applies it between two cycles) and wait for the answer.
+  for (int i = 0;
+       i < 200 && shared_.calibration_flag.load(std::memory_order_acquire) == SharedState::kPending;
+       ++i) {
+    sleep_ns(1'000'000);
+  }
+  shared_.calibration = cal;
+  shared_.calibration_flag.store(SharedState::kPending, std::memory_order_release);
+  if (!dsp_ready_.load(std::memory_order_acquire)) {
+    *message = "calibration " + calibration_.file.string() + " queued (the loop is not running)";
+    calibration_ = next;
+    return true;
+  }
+  for (int i = 0; i < 1000; ++i) {
+    const int f = shared_.calibration_flag.load(std::memory_order_acquire);
+    if (f == SharedState::kApplied) {
+      calibration_ = next;
+      *message = "calibration reloaded from " + calibration_.file.string();
+      return true;
+    }
+    if (f == SharedState::kRejected) {
+      *message = "calibration reload rejected by the pipeline, keeping the last good one: " +
+                 calibration_.file.string();
+      return false;
+    }
+    sleep_ns(1'000'000);
+  }
+  *message = "calibration reload: the DSP loop did not answer within 1 s";
+  return false;
+}
+
+void Daemon::capture_loop(std::size_t s) {
+  hal::Camera& cam = *cameras_[s];
+  FrameRing& ring = (*rings_)[s];
+  auto& sh = shared_.sensors[s];
+  const char* side = s == 0 ? "left" : "right";
+  std::uint64_t overflow = 0;
+  bool reported_error = false;
+  while (!stop_.load(std::memory_order_acquire)) {
+    hal::Frame f;
+    const hal::CameraStatus st = cam.next_frame(f, kCaptureTimeoutMs);
+    if (st.ok()) {
+      if (sh.disconnected.load(std::memory_order_relaxed))
+        say(1, "sensor %s: streaming again", side);
+      sh.disconnected.store(false, std::memory_order_release);
+      reported_error = false;
+      if (!ring.push(f)) {
+        // The DSP thread is behind by a whole ring: drop the newest, counted.
+        cam.release(f);
+        ++overflow;
+      } else {
+        sh.frames.fetch_add(1, std::memory_order_relaxed);
+      }
+      sh.camera_drops.store(cam.stats().drops + overflow, std::memory_order_relaxed);
+      continue;
+    }
+    switch (st.code) {
+      case hal::CameraError::kTimeout:
+      case hal::CameraError::kCorruptFrame:
+        break;
+      case hal::CameraError::kDisconnected:
+        sh.disconnected.store(true, std::memory_order_release);
+        say(1, "sensor %s lost: %s", side, st.message());
+        break;
+      default:
+        if (cam.link_state() == hal::LinkState::kDisconnected ||
+            cam.link_state() == hal::LinkState::kFailed) {
+          sh.disconnected.store(true, std::memory_order_release);
+        }
+        if (!reported_error) say(1, "sensor %s: %s", side, st.message());
+        reported_error = true;
+        sleep_ns(kCaptureTimeoutMs * 1'000'000LL);
+        break;
+    }
+  }
+}
+
+void Daemon::dsp_loop() {
+  const RealtimeResult rt = setup_realtime_thread(board_.realtime.dsp_priority,
+                                                  board_.realtime.dsp_cpu, kDspStackPrefault);
+  if (!rt.message.empty())
+    say(1, "real-time setup incomplete, running anyway: %s", rt.message.c_str());
+  engine_->start(hal::monotonic_ns());
+  dsp_ready_.store(true, std::memory_order_release);
+  while (!stop_.load(std::memory_order_acquire)) {
+    if (!engine_->step(hal::monotonic_ns())) sleep_ns(kIdleSleepNs);
+  }
+}
+
+void Daemon::rx_loop() {
+  protocol::Endpoint ep;
+  ep.node_id = static_cast<std::uint8_t>(board_.can.node_id);
+  ep.layout.mode =
+      board_.can.extended_ids ? protocol::IdMode::kExtended : protocol::IdMode::kStandard;
+  protocol::CommandReceiver receiver(ep);
+  CommandRing& ring = (*command_rings_)[0];
+  bool reported = false;
+  while (!stop_.load(std::memory_order_acquire)) {
+    hal::can::RxFrame rx;
+    const hal::can::RxResult r = channel_->receive(rx, kRxTimeoutMs);
+    if (r == hal::can::RxResult::kFrame) {
+      const protocol::CommandResult res = receiver.receive(rx.frame);
+      shared_.rejected_commands.store(receiver.stats().rejected(), std::memory_order_relaxed);
+      if (res.addressed && !ring.push(res)) say(1, "command queue full: command dropped");
+    } else if (r == hal::can::RxResult::kEnd) {
+      sleep_ns(kRxTimeoutMs * 1'000'000LL);  // no command input (log backend writing only)
+    } else if (r == hal::can::RxResult::kError) {
+      if (!reported) say(1, "CAN receive: %s", channel_->last_error().c_str());
+      reported = true;
+      sleep_ns(kRxTimeoutMs * 1'000'000LL);
+    }
+  }
+}
+
+void Daemon::housekeeping_tick(std::int64_t now_ns, bool handle_signals) {
+  if (handle_signals) {
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGHUP);
+    timespec zero{0, 0};
+    for (;;) {
+      const int sig = sigtimedwait(&set, nullptr, &zero);
+      if (sig < 0) break;
+      if (sig == SIGHUP) {
+        std::string msg;
+        reload_calibration(&msg);
+        say(0, "%s", msg.c_str());
+      } else {
+        say(1, "%s: stopping", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+        stop_.store(true, std::memory_order_release);
+      }
+    }
+  }
+  // Tare button.
+  const hal::GpioInputs in = gpio_controller_->take_inputs();
+  if (in.tare_presses > 0) {
+    tare_count_ += in.tare_presses;
+    shared_.tare_requests.store(tare_count_, std::memory_order_release);
+    say(1, "tare button pressed");
+  }
+  // State -> LED, log.
+  const std::uint8_t st = shared_.state.load(std::memory_order_relaxed);
+  if (st != last_state_) {
+    gpio_controller_->set_state(led_state(static_cast<protocol::State>(st)));
+    say(1, "state %s", protocol::to_string(static_cast<protocol::State>(st)));
+    last_state_ = st;
+  }
+  // CAN channel counters for the status frames (stats() may take a lock: not on the DSP thread).
+  const hal::can::ChannelStats cs = channel_->stats();
+  shared_.can_tx_dropped.store(cs.tx_dropped, std::memory_order_relaxed);
+  shared_.can_error_passive.store(cs.bus_state == hal::can::BusState::kErrorPassive ||
+                                      cs.bus_state == hal::can::BusState::kBusOff,
+                                  std::memory_order_relaxed);
+  // READY=1 once every configured sensor streams.
+  if (!ready_sent_) {
+    bool all = true;
+    for (std::size_t s = 0; s < 2; ++s) {
+      if (board_.sensors[s].enabled && shared_.sensors[s].frames.load() == 0) all = false;
+    }
+    if (all) {
+      ready_sent_ = true;
+      streaming_since_ns_ = now_ns;
+      notify("READY=1\nSTATUS=streaming");
+      say(1, "sensors streaming");
+    }
+  }
+  // Watchdog: only while the DSP loop's heartbeat advances.
+  if (watchdog_usec_ > 0 && now_ns >= next_watchdog_ns_) {
+    const std::uint64_t hb = shared_.heartbeat.load(std::memory_order_relaxed);
+    if (hb != last_heartbeat_) notify("WATCHDOG=1");
+    last_heartbeat_ = hb;
+    next_watchdog_ns_ = now_ns + watchdog_usec_ * 1000 / 2;
+  }
+  if (options_.verbosity >= 2 && now_ns >= next_verbose_ns_) {
+    next_verbose_ns_ = now_ns + 1'000'000'000;
+    say(2, "cycles %llu, emitted %llu, state %s",
+        static_cast<unsigned long long>(shared_.cycles.load()),
+        static_cast<unsigned long long>(shared_.emitted.load()),
+        protocol::to_string(static_cast<protocol::State>(st)));
+  }
+  if (options_.seconds > 0.0 && ready_sent_ &&
+      static_cast<double>(now_ns - streaming_since_ns_) * 1e-9 >= options_.seconds) {
+    stop_.store(true, std::memory_order_release);
+  }
+}
+
+int Daemon::run(bool handle_signals) {
+  watchdog_usec_ = watchdog_usec();
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (!cameras_[s]) continue;
+    const hal::CameraStatus st = cameras_[s]->start();
+    if (!st.ok()) {
+      say(0, "sensor %s: %s", s == 0 ? "left" : "right", st.message());
+      return 1;
+    }
+  }
+  gpio_controller_->start(hal::monotonic_ns());
+  std::thread dsp([this] { dsp_loop(); });
+  std::array<std::thread, 2> capture;
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (cameras_[s]) capture[s] = std::thread([this, s] { capture_loop(s); });
+  }
+  std::thread rx([this] { rx_loop(); });
+
+  while (!stop_.load(std::memory_order_acquire)) {
+    gpio_controller_->poll(5);  // also the housekeeping tick's sleep
+    housekeeping_tick(hal::monotonic_ns(), handle_signals);
+  }
+  const std::int64_t stop_ns = hal::monotonic_ns();
+  notify("STOPPING=1");
+  dsp.join();
+  for (auto& t : capture) {
+    if (t.joinable()) t.join();
+  }
+  rx.join();
+  engine_->release_all();
+  for (auto& c : cameras_) {
+    if (c) c->stop();
+  }
+  channel_->service();
+  summary_.streaming_s =
+      ready_sent_ ? static_cast<double>(stop_ns - streaming_since_ns_) * 1e-9 : 0.0;
+  finish_summary();
+  return 0;
+}
+
+void Daemon::finish_summary() {
+  summary_.engine = engine_->stats();
+  summary_.last_cycle = engine_->last_cycle();
+  summary_.latency_p50_us = engine_->latency_percentile_us(50);
+  summary_.latency_p99_us = engine_->latency_percentile_us(99);
+  summary_.dsp_p50_us = engine_->dsp_time_percentile_us(50);
+  const EngineStats& e = summary_.engine;
+  say(1,
+      "stopped after %.2f s of streaming: %llu samples (%llu pairs, %llu single), %llu cycles "
+      "sent, "
+      "latency p50 %lld us p99 %lld us, dsp p50 %lld us",
+      summary_.streaming_s, static_cast<unsigned long long>(e.samples),
+      static_cast<unsigned long long>(e.pairs), static_cast<unsigned long long>(e.singles),
+      static_cast<unsigned long long>(e.cycles_sent),
+      static_cast<long long>(summary_.latency_p50_us),
+      static_cast<long long>(summary_.latency_p99_us), static_cast<long long>(summary_.dsp_p50_us));
+  if (rig_ && e.cycles_sent > 0) {
+    const protocol::Cycle& c = summary_.last_cycle;
+    const std::int64_t t_ns = static_cast<std::int64_t>(c.timestamp_us) * 1000;
+    const sim::Pose truth = rig_->truth(t_ns);
+    const Eigen::Quaterniond q_est(c.orientation.w, c.orientation.x, c.orientation.y,
+                                   c.orientation.z);
+    const Eigen::Vector3d est = dsp::so3_log(q_est.normalized()) * kRadToDeg;
+    const Eigen::Vector3d tru = dsp::so3_log(truth.q.normalized()) * kRadToDeg;
+    const double err = q_est.normalized().angularDistance(truth.q.normalized()) * kRadToDeg;
+    summary_.have_truth = true;
+    for (int i = 0; i < 3; ++i) {
+      summary_.truth_rotation_deg[i] = tru[i];
+      summary_.estimated_rotation_deg[i] = est[i];
+    }
+    summary_.rotation_error_deg = err;
+    say(0,
+        "sim truth at the last cycle: rotation (%.2f, %.2f, %.2f) deg; sent estimate (%.2f, %.2f, "
+        "%.2f) deg; error %.2f deg",
+        tru.x(), tru.y(), tru.z(), est.x(), est.y(), est.z(), err);
+  }
+}
+
+}  // namespace tacse3::firmware

@@ -1,0 +1,467 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: the DSP loop body (pairing, pipeline, commands, cycle/status/ack frames).
+#include "tacse3/firmware/engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tacse3/hal/camera/clock.hpp"
+
+namespace tacse3::firmware {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Compile-time adapters for dsp API added at the same time (VelocityProxy::kAuto and the
+// per-frame slip flag): the firmware uses them as soon as they exist and builds without them.
+template <typename R>
+bool slipping(const R& r) noexcept {
+  if constexpr (requires { r.slipping; }) {
+    return static_cast<bool>(r.slipping);
+  } else {
+    return false;
+  }
+}
+
+template <typename E>
+constexpr bool has_auto_proxy() noexcept {
+  if constexpr (requires { E::kAuto; }) {
+    return true;
+  } else {
+    return false;
+  }
+}
+
+template <typename E>
+E auto_proxy(E fallback) noexcept {
+  if constexpr (requires { E::kAuto; }) {
+    return E::kAuto;
+  } else {
+    return fallback;
+  }
+}
+
+double clamp01_or_nan(double v) noexcept {
+  return std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : kNaN;
+}
+
+double us_to_s(std::int64_t us) noexcept {
+  return us < 0 ? kNaN : static_cast<double>(us) * 1e-6;
+}
+
+// Contact area of one sensor: |Ω| flow-grid cells of (320 / kGridWidth) sensor pixels squared.
+double contact_area_m2(const dsp::SensorPipeline& p) noexcept {
+  const auto& cal = p.calibration();
+  const double cell_m =
+      cal.pixel_pitch_m * (static_cast<double>(dsp::kSensorWidth) / dsp::kGridWidth);
+  return static_cast<double>(p.fields().contact.count) * cell_m * cell_m * cal.pixel_aspect_y;
+}
+
+}  // namespace
+
+dsp::VelocityProxy to_dsp_proxy(protocol::VelocityMode m, dsp::VelocityProxy calibrated) noexcept {
+  switch (m) {
+    case protocol::VelocityMode::kVelocity:
+      return dsp::VelocityProxy::kVelocity;
+    case protocol::VelocityMode::kDisplacement:
+      return dsp::VelocityProxy::kDisplacement;
+    case protocol::VelocityMode::kAuto:
+      break;
+  }
+  return auto_proxy<dsp::VelocityProxy>(calibrated);
+}
+
+protocol::FusionMethod to_protocol(dsp::FusionMethod m) noexcept {
+  return m == dsp::FusionMethod::kPaper ? protocol::FusionMethod::kPaper
+                                        : protocol::FusionMethod::kJoint;
+}
+
+dsp::FusionMethod to_dsp(protocol::FusionMethod m) noexcept {
+  return m == protocol::FusionMethod::kPaper ? dsp::FusionMethod::kPaper
+                                             : dsp::FusionMethod::kJoint;
+}
+
+Engine::Engine(const EngineConfig& config, dsp::DualPipeline& pipeline, hal::can::Channel& channel,
+               std::array<hal::Camera*, 2> cameras, std::array<FrameRing*, 2> rings,
+               std::array<CommandRing*, 2> command_rings, SharedState& shared) noexcept
+    : config_(config),
+      pipeline_(pipeline),
+      channel_(channel),
+      cameras_(cameras),
+      rings_(rings),
+      command_rings_(command_rings),
+      shared_(shared),
+      machine_(config.health),
+      rate_divider_(config.rate_divider),
+      stream_enabled_(config.stream_enabled),
+      velocity_mode_(config.velocity_mode) {
+  for (std::size_t s = 0; s < 2; ++s) observed_[s].configured = config.configured[s];
+  base_calibration_ = {pipeline.sensor(dsp::SensorSlot::kLeft).calibration(),
+                       pipeline.sensor(dsp::SensorSlot::kRight).calibration()};
+}
+
+void Engine::start(std::int64_t now_ns) noexcept {
+  machine_.start(now_ns);
+  next_status_ns_ = now_ns;
+  state_ = machine_.update({observed_, false}, now_ns);
+  shared_.state.store(static_cast<std::uint8_t>(state_.state), std::memory_order_relaxed);
+  tare_seen_ = shared_.tare_requests.load(std::memory_order_acquire);
+}
+
+bool Engine::send(const protocol::CanFrame& f) noexcept {
+  if (channel_.send(f)) return true;
+  ++stats_.send_failures;
+  return false;
+}
+
+void Engine::refill_heads(std::int64_t now_ns) noexcept {
+  for (std::size_t s = 0; s < 2; ++s) {
+    Head& h = heads_[s];
+    if (h.pending.present || rings_[s] == nullptr) continue;
+    if (rings_[s]->pop(h.frame)) {
+      h.pending.present = true;
+      h.pending.t_ns = h.frame.timestamp_ns;
+      h.pending.arrival_ns = now_ns;
+      observed_[s].seen = true;
+      observed_[s].last_frame_ns = now_ns;
+    }
+  }
+}
+
+void Engine::release_head(std::size_t s) noexcept {
+  Head& h = heads_[s];
+  if (!h.pending.present) return;
+  if (cameras_[s] != nullptr) cameras_[s]->release(h.frame);
+  h.pending.present = false;
+}
+
+void Engine::release_all() noexcept {
+  for (std::size_t s = 0; s < 2; ++s) {
+    release_head(s);
+    if (rings_[s] == nullptr) continue;
+    hal::Frame f;
+    while (rings_[s]->pop(f)) {
+      if (cameras_[s] != nullptr) cameras_[s]->release(f);
+    }
+  }
+}
+
+void Engine::apply_pending_calibration() noexcept {
+  if (shared_.calibration_flag.load(std::memory_order_acquire) != SharedState::kPending) return;
+  std::array<dsp::Calibration, 2> cal = shared_.calibration;
+  // The running proxy mode survives a reload (AUTO keeps meaning "the file's proxy").
+  if (velocity_mode_ != protocol::VelocityMode::kAuto) {
+    for (std::size_t s = 0; s < 2; ++s) {
+      cal[s].velocity_proxy = to_dsp_proxy(velocity_mode_, cal[s].velocity_proxy);
+    }
+  }
+  const bool ok = pipeline_.set_calibration(cal) == dsp::Status::kOk;
+  if (ok) base_calibration_ = shared_.calibration;
+  shared_.calibration_invalid.store(!ok, std::memory_order_relaxed);
+  shared_.calibration_flag.store(ok ? SharedState::kApplied : SharedState::kRejected,
+                                 std::memory_order_release);
+}
+
+bool Engine::apply(const protocol::Command& c) noexcept {
+  using protocol::CommandCode;
+  switch (c.code) {
+    case CommandCode::kTare:
+      pipeline_.tare();
+      return true;
+    case CommandCode::kResetPose:
+      pipeline_.reset_pose();
+      pose_reset_pending_ = true;
+      return true;
+    case CommandCode::kSetFingerSeparation:
+      return pipeline_.set_finger_separation(c.finger_separation_m) == dsp::Status::kOk;
+    case CommandCode::kSetFusion: {
+      // Both parts or neither: the proxy is the one that can fail, so it goes first and the
+      // method (which cannot fail for a validated value) second.
+      const dsp::VelocityProxy proxy =
+          to_dsp_proxy(c.velocity_mode, base_calibration_[0].velocity_proxy);
+      dsp::Status st;
+      if (c.velocity_mode == protocol::VelocityMode::kAuto &&
+          !has_auto_proxy<dsp::VelocityProxy>()) {
+        st = pipeline_.set_calibration(base_calibration_);
+      } else {
+        st = pipeline_.set_velocity_proxy(proxy);
+      }
+      if (st != dsp::Status::kOk) return false;
+      if (pipeline_.set_fusion_method(to_dsp(c.fusion)) != dsp::Status::kOk) return false;
+      velocity_mode_ = c.velocity_mode;
+      return true;
+    }
+    case CommandCode::kSetRateDivider:
+      rate_divider_ = c.rate_divider;
+      return true;
+    case CommandCode::kSetStream:
+      stream_enabled_ = c.stream_enabled;
+      return true;
+    case CommandCode::kQuery:
+      return true;
+  }
+  return false;
+}
+
+void Engine::handle_command(const protocol::CommandResult& r) noexcept {
+  if (!r.addressed) return;
+  protocol::Ack ack = protocol::make_ack(r);
+  if (r.code == protocol::AckCode::kAck) {
+    if (!apply(r.command)) {
+      ack.result = protocol::AckCode::kInternalError;
+    } else if (r.command.code == protocol::CommandCode::kQuery) {
+      protocol::QueryReply q;
+      q.item = r.command.query;
+      switch (q.item) {
+        case protocol::QueryItem::kProtocolVersion:
+          q.version = {protocol::kProtocolVersionMajor, protocol::kProtocolVersionMinor,
+                       protocol::kProtocolVersionPatch};
+          break;
+        case protocol::QueryItem::kFirmwareVersion:
+          q.version = {TACSE3_VERSION_MAJOR, TACSE3_VERSION_MINOR, TACSE3_VERSION_PATCH};
+          break;
+        default:
+          break;
+      }
+      q.finger_separation_m = pipeline_.config().finger_separation_m;
+      q.fusion = to_protocol(pipeline_.config().fusion.method);
+      q.velocity_mode = velocity_mode_;
+      q.stream_enabled = stream_enabled_;
+      q.rate_divider = rate_divider_;
+      q.fd_mode = config_.tx.frame_mode == protocol::FrameMode::kFd;
+      q.extended_ids = config_.tx.endpoint.layout.mode == protocol::IdMode::kExtended;
+      ack = protocol::make_query_reply(r.command, q);
+    }
+  }
+  protocol::CanFrame f;
+  if (protocol::encode(ack, config_.tx, f) == protocol::Status::kOk) send(f);
+  ++stats_.commands;
+}
+
+void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcept {
+  const dsp::FrameView* l = use_left ? &heads_[0].frame.view : nullptr;
+  const dsp::FrameView* r = use_right ? &heads_[1].frame.view : nullptr;
+  std::int64_t t_ns = INT64_MIN;
+  std::int64_t t_first_ns = INT64_MAX;
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (!(s == 0 ? use_left : use_right)) continue;
+    t_ns = std::max(t_ns, heads_[s].pending.t_ns);
+    t_first_ns = std::min(t_first_ns, heads_[s].pending.t_ns);
+  }
+  const std::int64_t t0 = hal::monotonic_ns();
+  pipeline_.process(l, r, t_ns, result_);
+  const std::int64_t t1 = hal::monotonic_ns();
+  dsp_time_.add(
+      static_cast<std::uint32_t>(std::clamp<std::int64_t>((t1 - t0) / 1000, 0, UINT32_MAX)));
+  have_result_ = true;
+  last_t_ns_ = t_ns;
+  if (use_left && use_right) last_pair_t_ns_ = t_ns;
+  if (use_left) release_head(0);
+  if (use_right) release_head(1);
+  ++stats_.samples;
+  (use_left && use_right ? stats_.pairs : stats_.singles) += 1;
+  shared_.cycles.store(stats_.samples, std::memory_order_relaxed);
+  status_sent_this_cycle_ = false;
+
+  for (std::size_t s = 0; s < 2; ++s) {
+    const bool present = result_.present[s];
+    const bool c = present && result_.fused.contact[s];
+    const bool sl = present && slipping(result_.sensors[s]);
+    if (c != contact_[s] || sl != slip_[s]) status_dirty_ = true;
+    contact_[s] = c;
+    slip_[s] = sl;
+  }
+
+  const bool emit = stream_enabled_ && (sample_index_ % rate_divider_) == 0;
+  ++sample_index_;
+  if (!emit) return;
+  protocol::Cycle c;
+  c.timestamp_us = static_cast<std::uint64_t>(std::max<std::int64_t>(t_ns, 0) / 1000);
+  c.estimate_valid = result_.valid;
+  c.single_sensor = result_.single_sensor || !(use_left && use_right);
+  c.pose_reset = pose_reset_pending_;
+  c.angular = {result_.twist[0], result_.twist[1], result_.twist[2]};
+  c.linear = {result_.twist[3], result_.twist[4], result_.twist[5]};
+  c.orientation = {result_.pose.q.w(), result_.pose.q.x(), result_.pose.q.y(), result_.pose.q.z()};
+  c.position = {result_.pose.p.x(), result_.pose.p.y(), result_.pose.p.z()};
+  if (protocol::encode_cycle(c, cycle_counter_, config_.tx, cycle_frames_) !=
+      protocol::Status::kOk) {
+    return;
+  }
+  bool all_sent = true;
+  for (std::size_t i = 0; i < cycle_frames_.count; ++i)
+    all_sent = send(cycle_frames_.frames[i]) && all_sent;
+  const std::int64_t t_sent = hal::monotonic_ns();
+  // Frame timestamp -> last frame of the cycle handed to the channel. Only meaningful when the
+  // camera stamps on CLOCK_MONOTONIC; anything outside (0, 10 s) is not a latency.
+  const std::int64_t latency_ns = t_sent - t_first_ns;
+  if (latency_ns > 0 && latency_ns < 10'000'000'000) {
+    latency_.add(static_cast<std::uint32_t>(latency_ns / 1000));
+  }
+  pose_reset_pending_ = false;
+  cycle_counter_ = static_cast<std::uint8_t>((cycle_counter_ + 1) & 0x0F);
+  last_cycle_ = cycle_frames_.sent;
+  if (all_sent) ++stats_.cycles_sent;
+  shared_.emitted.store(stats_.cycles_sent, std::memory_order_relaxed);
+  (void)now_ns;
+}
+
+protocol::StatusMsg Engine::status_message() const noexcept {
+  protocol::StatusMsg m;
+  m.state = state_.state;
+  m.health_left = state_.health[0];
+  m.health_right = state_.health[1];
+  m.contact_left = contact_[0];
+  m.contact_right = contact_[1];
+  m.slip_left = slip_[0];
+  m.slip_right = slip_[1];
+  m.stream_enabled = stream_enabled_;
+  m.fusion = to_protocol(pipeline_.config().fusion.method);
+  m.velocity_mode = velocity_mode_;
+  m.confidence = have_result_ && result_.valid ? clamp01_or_nan(result_.fused.confidence) : kNaN;
+  m.rate_divider = rate_divider_;
+  m.fault = state_.fault;
+  if (m.fault == FaultCode::kNone && shared_.calibration_invalid.load(std::memory_order_relaxed)) {
+    m.fault = FaultCode::kCalibrationInvalid;
+  }
+  if (m.fault == FaultCode::kNone && shared_.can_error_passive.load(std::memory_order_relaxed)) {
+    m.fault = FaultCode::kCanErrorPassive;
+  }
+  m.rejected_commands =
+      static_cast<std::uint8_t>(shared_.rejected_commands.load(std::memory_order_relaxed));
+  return m;
+}
+
+void Engine::send_status_group() noexcept {
+  protocol::StatusGroup g;
+  g.status = status_message();
+  for (std::size_t s = 0; s < 2; ++s) {
+    const auto& p = pipeline_.sensor(static_cast<dsp::SensorSlot>(s));
+    const bool present = have_result_ && state_.health[s] == SensorHealth::kOk;
+    const double area = present ? contact_area_m2(p) : kNaN;
+    const double conf =
+        present ? static_cast<double>(result_.sensors[s].tracked_points) / dsp::kGridCount : kNaN;
+    (s == 0 ? g.contact.area_left_m2 : g.contact.area_right_m2) = area;
+    (s == 0 ? g.contact.confidence_left : g.contact.confidence_right) = conf;
+  }
+  g.timing.dsp_time_s = us_to_s(dsp_time_.percentile(50));
+  g.timing.latency_p50_s = us_to_s(latency_.percentile(50));
+  g.timing.latency_p99_s = us_to_s(latency_.percentile(99));
+  for (std::size_t s = 0; s < 2; ++s) {
+    const std::uint64_t d =
+        shared_.sensors[s].camera_drops.load(std::memory_order_relaxed) + pairing_drops_[s];
+    (s == 0 ? g.counters.dropped_left : g.counters.dropped_right) = static_cast<std::uint16_t>(d);
+  }
+  g.counters.can_tx_dropped =
+      static_cast<std::uint16_t>(shared_.can_tx_dropped.load(std::memory_order_relaxed));
+  std::array<protocol::CanFrame, 4> frames;
+  if (protocol::encode_status_group(g, status_counter_, config_.tx, frames) ==
+      protocol::Status::kOk) {
+    for (const auto& f : frames) send(f);
+  }
+  status_counter_ = static_cast<std::uint8_t>((status_counter_ + 1) & 0x0F);
+  status_sent_this_cycle_ = true;
+  status_dirty_ = false;
+  ++stats_.status_groups;
+}
+
+void Engine::send_status_change() noexcept {
+  // A change-triggered Status is the Status frame alone with the next status counter value
+  // (docs/can-protocol.md); the group encoder is what stamps that counter.
+  protocol::StatusGroup g;
+  g.status = status_message();
+  std::array<protocol::CanFrame, 4> frames;
+  if (protocol::encode_status_group(g, status_counter_, config_.tx, frames) ==
+      protocol::Status::kOk) {
+    send(frames[0]);
+  }
+  status_counter_ = static_cast<std::uint8_t>((status_counter_ + 1) & 0x0F);
+  status_sent_this_cycle_ = true;
+  status_dirty_ = false;
+  ++stats_.status_changes;
+}
+
+void Engine::update_state(std::int64_t now_ns) noexcept {
+  for (std::size_t s = 0; s < 2; ++s) {
+    observed_[s].disconnected = shared_.sensors[s].disconnected.load(std::memory_order_acquire);
+  }
+  const StateOutput next = machine_.update({observed_, contact_[0] || contact_[1]}, now_ns);
+  if (next.state != state_.state || next.health != state_.health) status_dirty_ = true;
+  if (next.state == State::kDegradedSingleSensor && state_.state != next.state &&
+      last_pair_t_ns_ != INT64_MIN) {
+    stats_.degraded_after_pair_ns = last_t_ns_ - last_pair_t_ns_;
+  }
+  state_ = next;
+  shared_.state.store(static_cast<std::uint8_t>(state_.state), std::memory_order_relaxed);
+}
+
+bool Engine::step(std::int64_t now_ns) noexcept {
+  bool worked = false;
+  shared_.heartbeat.fetch_add(1, std::memory_order_relaxed);
+  apply_pending_calibration();
+
+  // Commands first: they apply between two cycles, all or nothing.
+  for (CommandRing* ring : command_rings_) {
+    protocol::CommandResult r;
+    while (ring != nullptr && ring->pop(r)) {
+      handle_command(r);
+      worked = true;
+    }
+  }
+  const std::uint32_t taps = shared_.tare_requests.load(std::memory_order_acquire);
+  if (taps != tare_seen_) {
+    tare_seen_ = taps;
+    pipeline_.tare();
+    worked = true;
+  }
+
+  for (int guard = 0; guard < 16; ++guard) {
+    refill_heads(now_ns);
+    update_state(now_ns);
+    const bool left_alive = state_.health[0] == SensorHealth::kOk;
+    const bool right_alive = state_.health[1] == SensorHealth::kOk;
+    const PairAction a = decide_pairing(heads_[0].pending, heads_[1].pending, left_alive,
+                                        right_alive, last_t_ns_, now_ns, config_.pairing);
+    if (a == PairAction::kWait) break;
+    worked = true;
+    switch (a) {
+      case PairAction::kPair:
+        process(true, true, now_ns);
+        break;
+      case PairAction::kLeftAlone:
+        process(true, false, now_ns);
+        break;
+      case PairAction::kRightAlone:
+        process(false, true, now_ns);
+        break;
+      case PairAction::kDropLeft:
+      case PairAction::kDropRight: {
+        const std::size_t s = a == PairAction::kDropLeft ? 0 : 1;
+        release_head(s);
+        ++pairing_drops_[s];
+        ++stats_.dropped_late;
+        break;
+      }
+      case PairAction::kWait:
+        break;
+    }
+  }
+  update_state(now_ns);
+
+  // Status: the periodic group at 10 Hz; a change-triggered Status at most once per cycle.
+  if (now_ns >= next_status_ns_) {
+    send_status_group();
+    next_status_ns_ += config_.status_period_ns;
+    if (next_status_ns_ <= now_ns) next_status_ns_ = now_ns + config_.status_period_ns;
+    worked = true;
+  } else if (status_dirty_ && !status_sent_this_cycle_) {
+    send_status_change();
+    worked = true;
+  }
+  channel_.service();
+  return worked;
+}
+
+}  // namespace tacse3::firmware

@@ -1,0 +1,223 @@
+// SPDX-License-Identifier: Apache-2.0
+// firmware tests: board files (the shipped ones and bad ones), resolution, calibration loading.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "tacse3/firmware/board.hpp"
+#include "tacse3/firmware/daemon.hpp"
+
+namespace fs = std::filesystem;
+using namespace tacse3;
+using namespace tacse3::firmware;
+
+namespace {
+
+const char* kMinimal = "version = 1\n[sensors.left]\nbackend = \"sim\"\n";
+
+// Parses text that must fail; returns the message.
+std::string error_of(const std::string& text) {
+  BoardConfig b;
+  b.name = "untouched";
+  std::string e;
+  EXPECT_FALSE(parse_board(text, "test.toml", &b, &e)) << text;
+  EXPECT_EQ(b.name, "untouched") << "a failed parse must leave the output unchanged";
+  return e;
+}
+
+fs::path scratch_dir() {
+  const fs::path d = fs::temp_directory_path() / ("tacse3-fw-board-" + std::to_string(getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+}  // namespace
+
+TEST(Board, ShippedBoardsLoad) {
+  for (const char* name : {"sim", "rpi4-uvc", "rpi5-libcamera"}) {
+    BoardConfig b;
+    std::string e;
+    ASSERT_TRUE(load_board(fs::path(TACSE3_SOURCE_BOARDS_DIR) / name / "board.toml", &b, &e)) << e;
+    EXPECT_EQ(b.name, name);
+    EXPECT_EQ(b.sensor_count(), 2);
+    // Left pad R = I, right pad mirrored diag(1, -1, -1) (the paper's sign matrix).
+    EXPECT_EQ(b.sensors[0].rotation[1][1], 1.0);
+    EXPECT_EQ(b.sensors[1].rotation[1][1], -1.0);
+    EXPECT_EQ(b.sensors[1].rotation[2][2], -1.0);
+  }
+  BoardConfig uvc;
+  std::string e;
+  ASSERT_TRUE(load_board(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "rpi4-uvc/board.toml", &uvc, &e));
+  EXPECT_EQ(uvc.sensors[0].backend, CameraBackend::kV4l2);
+  EXPECT_EQ(uvc.sensors[1].device, "/dev/tacse3-right");
+  EXPECT_EQ(uvc.can.bitrate, 500000);
+  EXPECT_EQ(uvc.can.mode, protocol::FrameMode::kClassic);
+  EXPECT_EQ(uvc.gpio.lines.line(hal::GpioLine::kTareButton).offset, 27);
+  EXPECT_TRUE(uvc.gpio.lines.line(hal::GpioLine::kTareButton).active_low);
+  BoardConfig pi5;
+  ASSERT_TRUE(
+      load_board(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "rpi5-libcamera/board.toml", &pi5, &e));
+  EXPECT_EQ(pi5.can.mode, protocol::FrameMode::kFd);
+  EXPECT_EQ(pi5.can.data_bitrate, 2000000);
+  EXPECT_EQ(pi5.sensors[0].backend, CameraBackend::kLibcamera);
+  EXPECT_EQ(pi5.gpio.lines.line(hal::GpioLine::kStatusLed).name, "GPIO17");
+}
+
+TEST(Board, MissingTablesTakeTheDocumentedDefaults) {
+  BoardConfig b;
+  std::string e;
+  ASSERT_TRUE(parse_board(kMinimal, "min.toml", &b, &e)) << e;
+  EXPECT_TRUE(b.sensors[0].enabled);
+  EXPECT_FALSE(b.sensors[1].enabled);
+  EXPECT_EQ(b.sensors[0].fps, 120);
+  EXPECT_EQ(b.sensors[0].buffer_count, 4);
+  EXPECT_DOUBLE_EQ(b.pipeline.finger_separation_m, 0.040);
+  EXPECT_EQ(b.pipeline.pair_tolerance_us, 2000);
+  EXPECT_EQ(b.pipeline.stale_ms, 50);
+  EXPECT_EQ(b.pipeline.lost_ms, 500);
+  EXPECT_EQ(b.can.backend, CanBackend::kSocketCan);
+  EXPECT_EQ(b.can.interface, "can0");
+  EXPECT_EQ(b.can.node_id, 1);
+  EXPECT_EQ(b.can.tx_queue, 64);
+  EXPECT_EQ(b.gpio.backend, GpioBackendKind::kNull);
+  EXPECT_EQ(b.realtime.dsp_cpu, 3);
+  EXPECT_EQ(b.realtime.dsp_priority, 80);
+  EXPECT_EQ(b.sim.motion, "rz");
+  EXPECT_TRUE(b.sim.repeat);
+  // A right pad without a rotation gets the mirrored mount.
+  ASSERT_TRUE(parse_board("version = 1\n[sensors.right]\nbackend = \"sim\"\n", "r.toml", &b, &e));
+  EXPECT_EQ(b.sensors[1].rotation[1][1], -1.0);
+  EXPECT_EQ(b.sensors[1].rotation[2][2], -1.0);
+}
+
+TEST(Board, MissingKeysAreNamed) {
+  EXPECT_NE(
+      error_of("[sensors.left]\nbackend = \"sim\"\n").find("missing required key \"version\""),
+      std::string::npos);
+  EXPECT_NE(error_of("version = 1\n[sensors.left]\nfps = 120\n").find("sensors.left.backend"),
+            std::string::npos);
+  EXPECT_NE(error_of("version = 1\nname = \"x\"\n").find("no sensor"), std::string::npos);
+  const std::string dev = error_of("version = 1\n[sensors.left]\nbackend = \"v4l2\"\n");
+  EXPECT_NE(dev.find("sensors.left.device"), std::string::npos) << dev;
+}
+
+TEST(Board, UnknownKeysAreErrorsWithTheirLine) {
+  const std::string top =
+      error_of("version = 1\nnmae = \"typo\"\n[sensors.left]\nbackend = \"sim\"\n");
+  EXPECT_NE(top.find("unknown key \"nmae\""), std::string::npos) << top;
+  EXPECT_NE(top.find("test.toml:2"), std::string::npos) << top;
+  const std::string nested =
+      error_of("version = 1\n[sensors.left]\nbackend = \"sim\"\ndevcie = \"x\"\n");
+  EXPECT_NE(nested.find("unknown key \"sensors.left.devcie\""), std::string::npos) << nested;
+  EXPECT_NE(nested.find("allowed here"), std::string::npos) << nested;
+  const std::string gpio =
+      error_of(std::string(kMinimal) + "[gpio.status_led]\noffset = 1\nbias = \"pull-up\"\n");
+  EXPECT_NE(gpio.find("gpio.status_led.bias"), std::string::npos) << gpio;
+  EXPECT_NE(error_of(std::string(kMinimal) + "[sensors.middle]\nbackend = \"sim\"\n")
+                .find("sensors.middle"),
+            std::string::npos);
+}
+
+TEST(Board, WrongTypesAreNamed) {
+  const std::string fps =
+      error_of("version = 1\n[sensors.left]\nbackend = \"sim\"\nfps = \"120\"\n");
+  EXPECT_NE(fps.find("key \"sensors.left.fps\" must be an integer, got a string"),
+            std::string::npos)
+      << fps;
+  const std::string ext = error_of(std::string(kMinimal) + "[can]\nextended_ids = 1\n");
+  EXPECT_NE(ext.find("can.extended_ids"), std::string::npos) << ext;
+  const std::string w =
+      error_of(std::string(kMinimal) + "[pipeline]\nfinger_separation_m = \"40mm\"\n");
+  EXPECT_NE(w.find("pipeline.finger_separation_m\" must be a number"), std::string::npos) << w;
+  const std::string sens = error_of("version = 1\nsensors = 2\n");
+  EXPECT_NE(sens.find("\"sensors\" must be a table"), std::string::npos) << sens;
+  const std::string be = error_of("version = 1\n[sensors.left]\nbackend = \"usb\"\n");
+  EXPECT_NE(be.find("sim | replay | v4l2 | libcamera"), std::string::npos) << be;
+}
+
+TEST(Board, OutOfRangeValuesAreNamed) {
+  const std::string node = error_of(std::string(kMinimal) + "[can]\nnode_id = 64\n");
+  EXPECT_NE(node.find("key \"can.node_id\" must be in [1, 63], got 64"), std::string::npos) << node;
+  EXPECT_NE(error_of(std::string(kMinimal) + "[can]\nrate_divider = 0\n").find("can.rate_divider"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kMinimal) + "[pipeline]\nfinger_separation_m = 0.3\n")
+                .find("pipeline.finger_separation_m"),
+            std::string::npos);
+  EXPECT_NE(error_of("version = 1\n[sensors.left]\nbackend = \"sim\"\nwidth = 640\n")
+                .find("sensors.left.width"),
+            std::string::npos);
+  const std::string lost =
+      error_of(std::string(kMinimal) + "[pipeline]\nstale_ms = 100\nlost_ms = 50\n");
+  EXPECT_NE(lost.find("pipeline.lost_ms"), std::string::npos) << lost;
+  EXPECT_NE(error_of(std::string(kMinimal) + "[realtime]\ndsp_priority = 100\n")
+                .find("realtime.dsp_priority"),
+            std::string::npos);
+  const std::string rot = error_of(
+      "version = 1\n[sensors.left]\nbackend = \"sim\"\nrotation = [[1,0,0],[0,1,0],[0,0,-1]]\n");
+  EXPECT_NE(rot.find("sensors.left.rotation\" must be a rotation matrix"), std::string::npos)
+      << rot;
+  const std::string ver = error_of("version = 2\n[sensors.left]\nbackend = \"sim\"\n");
+  EXPECT_NE(ver.find("schema version 1"), std::string::npos) << ver;
+  const std::string syn = error_of("version = 1\n[sensors.left\n");
+  EXPECT_NE(syn.find("test.toml:2"), std::string::npos) << syn;
+  EXPECT_NE(syn.find("TOML syntax error"), std::string::npos) << syn;
+}
+
+TEST(Board, ResolvesNamesInTheDocumentedOrder) {
+  const fs::path dir = scratch_dir();
+  fs::create_directories(dir / "env/mine");
+  std::ofstream(dir / "env/mine/board.toml") << kMinimal;
+  std::string e;
+  // The source tree is the last resort.
+  unsetenv("TACSE3_BOARD_DIR");
+  EXPECT_EQ(resolve_board("sim", "", TACSE3_SOURCE_BOARDS_DIR, &e),
+            (fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml").lexically_normal());
+  // $TACSE3_BOARD_DIR comes first.
+  setenv("TACSE3_BOARD_DIR", (dir / "env").c_str(), 1);
+  EXPECT_EQ(resolve_board("mine", "", TACSE3_SOURCE_BOARDS_DIR, &e), (dir / "env/mine/board.toml"));
+  // <exe_dir>/../share/tacse3/boards.
+  fs::create_directories(dir / "prefix/share/tacse3/boards/pkg");
+  fs::create_directories(dir / "prefix/bin");
+  std::ofstream(dir / "prefix/share/tacse3/boards/pkg/board.toml") << kMinimal;
+  EXPECT_EQ(resolve_board("pkg", dir / "prefix/bin", "", &e),
+            (dir / "prefix/share/tacse3/boards/pkg/board.toml").lexically_normal());
+  // A path is used as is.
+  EXPECT_EQ(resolve_board((dir / "env/mine/board.toml").string(), "", "", &e),
+            dir / "env/mine/board.toml");
+  EXPECT_TRUE(resolve_board("nope", "", TACSE3_SOURCE_BOARDS_DIR, &e).empty());
+  EXPECT_NE(e.find("board \"nope\" not found"), std::string::npos) << e;
+  EXPECT_NE(e.find("/etc/tacse3/boards/nope/board.toml"), std::string::npos) << e;
+  EXPECT_TRUE(resolve_board("./missing.toml", "", "", &e).empty());
+  unsetenv("TACSE3_BOARD_DIR");
+  fs::remove_all(dir);
+}
+
+TEST(Calibration, BadFilesAreRejectedWithFileAndKey) {
+  const fs::path dir = scratch_dir();
+  const fs::path bad = dir / "bad.toml";
+  std::ofstream(bad)
+      << "format = \"tacse3-calibration\"\nversion = 1\n[sensor]\ncontact_tau_on = -1.0\n";
+  CalibrationSource c;
+  std::string e;
+  EXPECT_FALSE(load_calibration_source(bad.string(), &c, &e));
+  EXPECT_NE(e.find(bad.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("sensor.contact_tau_on"), std::string::npos) << e;
+  EXPECT_FALSE(load_calibration_source((dir / "absent.toml").string(), &c, &e));
+  EXPECT_NE(e.find("absent.toml"), std::string::npos) << e;
+  // The fitted simulator calibration loads and makes a valid pipeline configuration.
+  ASSERT_TRUE(load_calibration_source(TACSE3_SIM_CALIBRATION, &c, &e)) << e;
+  BoardConfig b;
+  ASSERT_TRUE(load_board(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml", &b, &e)) << e;
+  dsp::DualConfig dual;
+  std::array<dsp::Calibration, 2> cal;
+  ASSERT_TRUE(make_pipeline_config(b, c, &dual, &cal, &e)) << e;
+  EXPECT_DOUBLE_EQ(dual.finger_separation_m, 0.040);
+  EXPECT_DOUBLE_EQ(cal[0].pixel_pitch_m, 1e-4);
+  // velocity_proxy = "auto" keeps the file's proxy (velocity) until dsp has its own auto mode.
+  EXPECT_EQ(dual.fusion.extrinsics[1].R_GS(1, 1), -1.0);
+  fs::remove_all(dir);
+}
