@@ -22,6 +22,8 @@ PACKAGES=(
   libturbojpeg0-dev libgpiod-dev libcamera-dev
   # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks
   libsystemd-dev dpkg-dev file
+  # unit, sysusers and networkd checks of the packaging tests (systemd-analyze verify)
+  systemd
   # fuzzing (libFuzzer and sanitizer runtimes for clang)
   libclang-rt-14-dev
   # protocol cross-checks: python-can example and the independent DBC decoder (npm)

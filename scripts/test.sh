@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # tacse3: the test command. Builds and runs the host tests, the ASan+UBSan build and the aarch64
-# build under qemu-user, then the bounded protocol fuzzers. Exits non-zero on any failure.
+# build under qemu-user, then builds and checks the arm64/armhf .deb packages and runs the bounded
+# protocol fuzzers. Exits non-zero on any failure.
 # Usage: scripts/test.sh [preset ...]      (default: host host-sanitize aarch64)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,6 +20,13 @@ for preset in "${presets[@]}"; do
   ctest --preset "$preset" -j "$JOBS"
   summary+=("$preset: ok")
 done
+
+# The arm64 and armhf .deb packages, built and checked against tests/packaging/contents.txt.
+if [ "${TACSE3_SKIP_PACKAGE:-0}" != "1" ]; then
+  echo "=== .deb packages (arm64, armhf) ==="
+  scripts/package.sh
+  summary+=("package: ok")
+fi
 
 if [ -x fuzz/run.sh ] && [ "${TACSE3_SKIP_FUZZ:-0}" != "1" ]; then
   echo "=== protocol fuzzers (bounded) ==="

@@ -1,0 +1,48 @@
+# SPDX-License-Identifier: Apache-2.0
+# tacse3 .deb: cpack-time script (CPACK_PROJECT_CONFIG_FILE) setting Depends from the binaries.
+# CPACK_DEBIAN_PACKAGE_DEPENDS = the DT_NEEDED entries of the packaged binaries, each mapped to
+# its package through packaging/deb/shlibs.txt (an unmapped library is an error naming it).
+# Inputs from the generated caller: _readelf, _shlibs, _binaries.
+# cpack reads this with no project policies set: ask for the ones of the project (IN_LIST).
+cmake_policy(VERSION 3.25)
+file(STRINGS "${_shlibs}" _lines REGEX "^[^#]")
+set(_map_sonames "")
+foreach(line IN LISTS _lines)
+  string(REGEX MATCH "^([^ \t]+)[ \t]+([^ \t]+)[ \t]*(.*)$" _ "${line}")
+  if(NOT CMAKE_MATCH_1)
+    continue()
+  endif()
+  string(STRIP "${CMAKE_MATCH_3}" constraint)
+  list(APPEND _map_sonames "${CMAKE_MATCH_1}")
+  set("_dep_${CMAKE_MATCH_1}" "${CMAKE_MATCH_2}")
+  set("_ver_${CMAKE_MATCH_1}" "${constraint}")
+endforeach()
+
+file(STRINGS "${_binaries}" _bins)
+set(_deps "")
+foreach(bin IN LISTS _bins)
+  if(NOT EXISTS "${bin}")
+    message(FATAL_ERROR "tacse3 package: ${bin} is not built; build the target tacse3_package_programs first")
+  endif()
+  execute_process(COMMAND "${_readelf}" -d "${bin}" OUTPUT_VARIABLE dyn RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "tacse3 package: ${_readelf} -d ${bin} failed")
+  endif()
+  string(REGEX MATCHALL "\\(NEEDED\\)[^\n]*\\[[^]\n]+\\]" needed "${dyn}")
+  foreach(entry IN LISTS needed)
+    string(REGEX REPLACE ".*\\[([^]]+)\\]$" "\\1" soname "${entry}")
+    if(NOT soname IN_LIST _map_sonames)
+      message(FATAL_ERROR "tacse3 package: ${bin} needs ${soname}, which packaging/deb/shlibs.txt does not "
+                          "map to a Debian package; add its line there")
+    endif()
+    set(dep "${_dep_${soname}}")
+    if(_ver_${soname})
+      string(APPEND dep " ${_ver_${soname}}")
+    endif()
+    list(APPEND _deps "${dep}")
+  endforeach()
+endforeach()
+list(REMOVE_DUPLICATES _deps)
+list(SORT _deps)
+string(JOIN ", " CPACK_DEBIAN_PACKAGE_DEPENDS ${_deps})
+message(STATUS "tacse3 package: Depends: ${CPACK_DEBIAN_PACKAGE_DEPENDS}")
