@@ -164,11 +164,20 @@ void Engine::apply_pending_calibration() noexcept {
                                  std::memory_order_release);
 }
 
+// A tare re-takes both references, which also restarts the pose: docs/can-protocol.md defines the
+// pose as relative to the last pose reset or tare, and the next cycle carries PoseReset = 1 so a
+// controller knows the pose jumped (from the CAN command and from the tare button alike).
+void Engine::tare_and_reset_pose() noexcept {
+  pipeline_.tare();
+  pipeline_.reset_pose();
+  pose_reset_pending_ = true;
+}
+
 bool Engine::apply(const protocol::Command& c) noexcept {
   using protocol::CommandCode;
   switch (c.code) {
     case CommandCode::kTare:
-      pipeline_.tare();
+      tare_and_reset_pose();
       return true;
     case CommandCode::kResetPose:
       pipeline_.reset_pose();
@@ -413,7 +422,7 @@ bool Engine::step(std::int64_t now_ns) noexcept {
   const std::uint32_t taps = shared_.tare_requests.load(std::memory_order_acquire);
   if (taps != tare_seen_) {
     tare_seen_ = taps;
-    pipeline_.tare();
+    tare_and_reset_pose();
     worked = true;
   }
 

@@ -256,6 +256,35 @@ TEST_F(EngineTest, UnpluggedSensorDegradesAtOnceAndRecovers) {
   EXPECT_EQ(b.statuses.back().health_right, protocol::SensorHealth::kOk);
 }
 
+TEST_F(EngineTest, TareFromCommandOrButtonRestartsThePoseAndFlagsTheCycle) {
+  for (std::size_t i = 0; i < 40; ++i) tick(i);
+  protocol::Command tare;
+  tare.code = protocol::CommandCode::kTare;
+  tare.sequence = 3;
+  command(tare);
+  for (std::size_t i = 40; i < 60; ++i) tick(i);
+  shared_.tare_requests.fetch_add(1);  // the debounced tare button
+  for (std::size_t i = 60; i < 80; ++i) tick(i);
+
+  const auto b = decode();
+  ASSERT_EQ(b.acks.size(), 1u);
+  EXPECT_EQ(b.acks[0].command, protocol::CommandCode::kTare);
+  EXPECT_EQ(b.acks[0].result, protocol::AckCode::kAck);
+  ASSERT_EQ(b.cycles.size(), 80u);
+  std::vector<std::size_t> flagged;
+  for (std::size_t i = 0; i < b.cycles.size(); ++i) {
+    if (b.cycles[i].pose_reset) flagged.push_back(i);
+  }
+  // Exactly the first cycle after each tare, and the pose restarts there from identity.
+  ASSERT_EQ(flagged.size(), 2u);
+  EXPECT_EQ(flagged[0], 40u);
+  EXPECT_EQ(flagged[1], 60u);
+  for (std::size_t i : flagged) {
+    EXPECT_NEAR(b.cycles[i].orientation.w, 1.0, 1e-3) << "cycle " << i;
+    EXPECT_NEAR(b.cycles[i].position.x, 0.0, 1e-4) << "cycle " << i;
+  }
+}
+
 TEST_F(EngineTest, BothSensorsLostIsAFault) {
   for (std::size_t i = 0; i < 20; ++i) tick(i);
   shared_.sensors[0].disconnected.store(true);

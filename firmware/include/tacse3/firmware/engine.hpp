@@ -109,6 +109,7 @@ class Engine {
   void release_head(std::size_t s) noexcept;
   void process(bool use_left, bool use_right, std::int64_t now_ns) noexcept;
   void handle_command(const protocol::CommandResult& r) noexcept;
+  void tare_and_reset_pose() noexcept;
   bool apply(const protocol::Command& c) noexcept;
   void apply_pending_calibration() noexcept;
   void update_state(std::int64_t now_ns) noexcept;
