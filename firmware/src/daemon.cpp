@@ -19,6 +19,9 @@
 #include "tacse3/hal/gpio.hpp"
 #include "tacse3/hal/gpio/controller.hpp"
 #include "tacse3/sim/simulator.hpp"
+#if TACSE3_HAVE_REPLAY
+#include "tacse3/hal/camera/replay_camera.hpp"
+#endif
 #if TACSE3_HAVE_LIBCAMERA
 #include "tacse3/hal/camera/libcamera_camera.hpp"
 #endif
@@ -185,10 +188,25 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
                  ".backend \"libcamera\": this tacse3d was built without libcamera";
         return nullptr;
 #endif
-      case CameraBackend::kReplay:
+      case CameraBackend::kReplay: {
+#if TACSE3_HAVE_REPLAY
+        // A recording's own pad: the board's left sensor replays the recording's left pad. The
+        // [sim] table's realtime/repeat also pace and loop replayed sensors (docs/firmware.md).
+        hal::ReplayCameraConfig rc;
+        rc.dir = sc.device;
+        rc.right = s == 1;
+        rc.realtime = board.sim.realtime;
+        rc.loop = board.sim.repeat;
+        rc.buffer_count = sc.buffer_count;
+        d->cameras_[s] = hal::make_replay_camera(rc);
+        break;
+#else
         *error = board.origin + ": sensors." + side +
-                 ".backend \"replay\": the replay camera backend is not in this build yet";
+                 ".backend \"replay\": this tacse3d was built without the replay backend "
+                 "(libspng missing for this target)";
         return nullptr;
+#endif
+      }
     }
     const hal::CameraStatus st = d->cameras_[s]->open();
     if (!st.ok()) {
@@ -482,16 +500,22 @@ void Daemon::housekeeping_tick(std::int64_t now_ns, bool handle_signals) {
 
 int Daemon::run(bool handle_signals) {
   watchdog_usec_ = watchdog_usec();
+  gpio_controller_->start(hal::monotonic_ns());
+  // The DSP thread first: its real-time setup (mlockall, stack prefault) can take a while, and
+  // frames that arrive before it runs would overflow the capture rings (a replayed recording
+  // would lose its first frames, which hold the reference). Cameras start once it is looping.
+  std::thread dsp([this] { dsp_loop(); });
+  for (int i = 0; i < 2000 && !dsp_ready_.load(std::memory_order_acquire); ++i) sleep_ns(1'000'000);
   for (std::size_t s = 0; s < 2; ++s) {
     if (!cameras_[s]) continue;
     const hal::CameraStatus st = cameras_[s]->start();
     if (!st.ok()) {
       say(0, "sensor %s: %s", s == 0 ? "left" : "right", st.message());
+      stop_.store(true, std::memory_order_release);
+      dsp.join();
       return 1;
     }
   }
-  gpio_controller_->start(hal::monotonic_ns());
-  std::thread dsp([this] { dsp_loop(); });
   std::array<std::thread, 2> capture;
   for (std::size_t s = 0; s < 2; ++s) {
     if (cameras_[s]) capture[s] = std::thread([this, s] { capture_loop(s); });

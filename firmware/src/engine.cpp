@@ -429,8 +429,16 @@ bool Engine::step(std::int64_t now_ns) noexcept {
   for (int guard = 0; guard < 16; ++guard) {
     refill_heads(now_ns);
     update_state(now_ns);
-    const bool left_alive = state_.health[0] == SensorHealth::kOk;
-    const bool right_alive = state_.health[1] == SensorHealth::kOk;
+    // While booting, a configured sensor that has not delivered yet (and is not known lost) is
+    // waited for (up to the pairing's max wait), so the first instant is processed as a pair
+    // rather than as one pad alone because its partner's first frame came a moment later.
+    const bool booting = state_.state == protocol::State::kBooting;
+    const auto alive = [&](std::size_t s) {
+      return state_.health[s] == SensorHealth::kOk ||
+             (booting && observed_[s].configured && !observed_[s].disconnected);
+    };
+    const bool left_alive = alive(0);
+    const bool right_alive = alive(1);
     const PairAction a = decide_pairing(heads_[0].pending, heads_[1].pending, left_alive,
                                         right_alive, last_t_ns_, now_ns, config_.pairing);
     if (a == PairAction::kWait) break;

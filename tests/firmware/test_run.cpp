@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -180,3 +181,50 @@ TEST_F(RunTest, CheckAndErrorsUseTheDocumentedExitCodes) {
   EXPECT_EQ(r.status, 1) << r.out;
   EXPECT_NE(r.out.find("board \"no-such-board\" not found"), std::string::npos) << r.out;
 }
+
+#ifdef TACSE3_SIM_BIN
+TEST_F(RunTest, ReplayBoardStreamsEveryFramePairOfARecording) {
+  // A short recording from tacse3-sim, replayed by both sensors paced to its frames.csv times
+  // (like live sensors): one dual cycle per recorded frame pair, then both sensors report the end
+  // of the recording.
+  const fs::path rec = dir_ / "rec";
+  RunResult r = run_cmd(std::string(TACSE3_SIM_BIN) + " --out " + rec.string() +
+                        " --motion rz --magnitude 3 --approach-s 0.05 --grasp-s 0.2 --settle-s 0.05"
+                        " --hold-s 0.1 2>&1");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const std::size_t frames = split(read_all(rec / "frames.csv"), '\n').size() - 1;
+  ASSERT_GT(frames, 30u);
+
+  std::string text = read_all(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml");
+  const std::string key = "\nrepeat = ";  // play the recording once
+  const std::size_t repeat_at = text.find(key);
+  ASSERT_NE(repeat_at, std::string::npos) << key;
+  const std::size_t value = repeat_at + key.size();
+  text.replace(value, text.find('\n', value) - value, "false");
+  for (std::size_t at = 0; (at = text.find("backend = \"sim\"", at)) != std::string::npos;) {
+    const std::string repl = "backend = \"replay\"\ndevice = \"" + rec.string() + "\"";
+    text.replace(at, std::string("backend = \"sim\"").size(), repl);
+    at += repl.size();
+  }
+  std::ofstream(dir_ / "board.toml") << text;
+
+  const fs::path csv = dir_ / "replay.csv";
+  r = run_cmd(std::string(TACSE3D_BIN) + " --board " + (dir_ / "board.toml").string() +
+              " --seconds 2 --can-log - 2>" + (dir_ / "err.txt").string() + " | " +
+              TACSE3_CANMON_BIN + " --log - --format csv > " + csv.string() + " 2>/dev/null");
+  ASSERT_EQ(r.status, 0) << read_all(dir_ / "err.txt");
+  const std::vector<std::string> rows = split(read_all(csv), '\n');
+  ASSERT_GE(rows.size(), 2u);
+  const std::vector<std::string> header = split(rows[0], ',');
+  const auto col = [&](const char* name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  std::size_t dual = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const std::vector<std::string> f = split(rows[i], ',');
+    if (f.size() > col("single_sensor") && f[col("single_sensor")] == "0") ++dual;
+  }
+  EXPECT_EQ(dual, frames) << read_all(dir_ / "err.txt");
+  EXPECT_NE(read_all(dir_ / "err.txt").find("end of recording"), std::string::npos);
+}
+#endif
