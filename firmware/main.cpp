@@ -70,12 +70,6 @@ int main(int argc, char** argv) {
     std::printf("ok\n");
     return 0;
   }
-  if (!opt.record_dir.empty()) {
-    std::fprintf(stderr,
-                 "tacse3d: --record %s: the streaming recording writer is not in this build; "
-                 "streaming without recording\n",
-                 opt.record_dir.c_str());
-  }
 
   // Signals are taken synchronously by the housekeeping loop (sigtimedwait), so they are blocked
   // in every thread, which inherit this mask. A closed stdout (the reader went away) must not

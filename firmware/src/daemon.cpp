@@ -11,6 +11,13 @@
 
 #include "tacse3/dsp/se3.hpp"
 #include "tacse3/firmware/system.hpp"
+#if TACSE3_HAVE_RECORDER
+#include "tacse3/firmware/recorder.hpp"
+#else
+namespace tacse3::firmware {
+class FrameRecorder {};  // --record is not built in; the member stays null
+}  // namespace tacse3::firmware
+#endif
 #include "tacse3/hal/camera/clock.hpp"
 #include "tacse3/hal/camera/sim_camera.hpp"
 #include "tacse3/hal/camera/v4l2_camera.hpp"
@@ -277,6 +284,33 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
   d->engine_ = std::make_unique<Engine>(
       ec, *d->pipeline_, *d->channel_, cams, rings,
       std::array<CommandRing*, 2>{&(*d->command_rings_)[0], &(*d->command_rings_)[1]}, d->shared_);
+
+  // --record DIR: what the DSP thread processes, written off the DSP path (docs/firmware.md).
+  if (!options.record_dir.empty()) {
+#if TACSE3_HAVE_RECORDER
+    RecorderConfig rc;
+    const SensorBoardConfig& s0 = board.sensors[0].enabled ? board.sensors[0] : board.sensors[1];
+    rc.width = s0.width;
+    rc.height = s0.height;
+    rc.fps = s0.fps;
+    for (std::size_t s = 0; s < 2; ++s) {
+      rc.sensors[s] = board.sensors[s].enabled;
+      if (d->cameras_[s]) rc.formats[s] = d->cameras_[s]->info().format;
+    }
+    rc.pixel_pitch_mm = cal[0].pixel_pitch_m * 1e3;
+    rc.finger_separation_mm = board.pipeline.finger_separation_m * 1e3;
+    std::string e;
+    d->recorder_ = FrameRecorder::start(options.record_dir, rc, &e);
+    if (!d->recorder_) {
+      *error = e;
+      return nullptr;
+    }
+    d->engine_->set_recorder(d->recorder_.get());
+#else
+    *error = "--record: this tacse3d was built without the recording writer (libspng missing)";
+    return nullptr;
+#endif
+  }
   return d;
 }
 
@@ -425,6 +459,13 @@ void Daemon::rx_loop() {
 }
 
 void Daemon::housekeeping_tick(std::int64_t now_ns, bool handle_signals) {
+#if TACSE3_HAVE_RECORDER
+  // A write error (disk full, directory gone) stops the recording, never the stream.
+  if (recorder_ && !recording_failure_reported_ && recorder_->failed()) {
+    recording_failure_reported_ = true;
+    say(0, "recording stopped, streaming goes on: %s", recorder_->error().c_str());
+  }
+#endif
   if (handle_signals) {
     sigset_t set;
     sigemptyset(&set);
@@ -538,6 +579,19 @@ int Daemon::run(bool handle_signals) {
     if (c) c->stop();
   }
   channel_->service();
+#if TACSE3_HAVE_RECORDER
+  if (recorder_) {
+    const std::string e = recorder_->close();
+    const recording::StreamWriterStats rs = recorder_->stats();
+    if (!e.empty()) {
+      say(0, "recording: %s", e.c_str());
+    } else {
+      say(1, "recording %s: %llu frames written, %llu dropped (ring full)",
+          options_.record_dir.c_str(), static_cast<unsigned long long>(rs.written),
+          static_cast<unsigned long long>(rs.dropped_full));
+    }
+  }
+#endif
   summary_.streaming_s =
       ready_sent_ ? static_cast<double>(stop_ns - streaming_since_ns_) * 1e-9 : 0.0;
   finish_summary();

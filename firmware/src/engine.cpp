@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // tacse3 firmware: the DSP loop body (pairing, pipeline, commands, cycle/status/ack frames).
 #include "tacse3/firmware/engine.hpp"
+#if TACSE3_HAVE_RECORDER
+#include "tacse3/firmware/recorder.hpp"
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -264,6 +267,9 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   const std::int64_t t1 = hal::monotonic_ns();
   dsp_time_.add(
       static_cast<std::uint32_t>(std::clamp<std::int64_t>((t1 - t0) / 1000, 0, UINT32_MAX)));
+#if TACSE3_HAVE_RECORDER
+  if (recorder_ != nullptr) recorder_->record(t_ns, l, r);
+#endif
   have_result_ = true;
   last_t_ns_ = t_ns;
   if (use_left && use_right) last_pair_t_ns_ = t_ns;

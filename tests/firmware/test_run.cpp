@@ -19,6 +19,10 @@
 
 #include "bus_events.hpp"
 
+#if TACSE3_HAVE_RECORDER
+#include "tacse3/recording/recording.hpp"
+#endif
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -226,5 +230,41 @@ TEST_F(RunTest, ReplayBoardStreamsEveryFramePairOfARecording) {
   }
   EXPECT_EQ(dual, frames) << read_all(dir_ / "err.txt");
   EXPECT_NE(read_all(dir_ / "err.txt").find("end of recording"), std::string::npos);
+}
+#endif
+
+#if TACSE3_HAVE_RECORDER
+TEST_F(RunTest, RecordWritesTheProcessedPairsAsARecording) {
+  const fs::path rec = dir_ / "recorded";
+  const RunResult r =
+      run_cmd(std::string(TACSE3D_BIN) + " --board sim --seconds 1 --can-log " +
+              (dir_ / "can.log").string() + " --record " + rec.string() + " --verbose 2>&1");
+  ASSERT_EQ(r.status, 0) << r.out;
+  auto reader = tacse3::recording::RecordingReader::open(rec);
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  const tacse3::recording::RecordingReader& rd = reader.value();
+  EXPECT_EQ(rd.info().sensors.size(), 2u);
+  // The daemon reports how many pairs it processed and how many frames the recording holds.
+  const std::size_t pairs_at = r.out.find(" pairs, ");
+  ASSERT_NE(pairs_at, std::string::npos) << r.out;
+  const std::size_t open_paren = r.out.rfind('(', pairs_at);
+  const std::size_t pairs = std::stoul(r.out.substr(open_paren + 1, pairs_at - open_paren - 1));
+  EXPECT_GT(pairs, 60u);
+  EXPECT_EQ(rd.frame_count(), pairs) << r.out;
+  for (std::size_t i = 1; i < rd.frame_count(); ++i) {
+    ASSERT_GT(rd.t_ns(i), rd.t_ns(i - 1));
+  }
+  tacse3::recording::Image img;
+  ASSERT_TRUE(rd.read_image(1, rd.frame_count() - 1, &img)) << "right pad, last frame";
+  EXPECT_EQ(img.width, 320);
+  EXPECT_EQ(img.height, 240);
+}
+
+TEST_F(RunTest, RecordIntoAnUnwritablePlaceIsAClearStartError) {
+  const RunResult r = run_cmd(std::string(TACSE3D_BIN) +
+                              " --board sim --seconds 1 --can-log /dev/null --record "
+                              "/proc/tacse3-cannot-write-here 2>&1");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("--record /proc/tacse3-cannot-write-here"), std::string::npos) << r.out;
 }
 #endif

@@ -24,6 +24,8 @@ class GpioController;
 
 namespace tacse3::firmware {
 
+class FrameRecorder;
+
 // Where the calibration came from: built-in defaults or a file (reloaded on SIGHUP).
 struct CalibrationSource {
   std::filesystem::path file;  // empty: built-in defaults
@@ -101,6 +103,8 @@ class Daemon {
   std::unique_ptr<std::array<FrameRing, 2>> rings_;
   std::unique_ptr<std::array<CommandRing, 2>> command_rings_;  // [0] CAN RX, [1] local
   std::unique_ptr<Engine> engine_;
+  std::unique_ptr<FrameRecorder> recorder_;  // --record (null: not recording)
+  bool recording_failure_reported_ = false;
   SharedState shared_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> dsp_ready_{false};

@@ -20,6 +20,8 @@
 
 namespace tacse3::firmware {
 
+class FrameRecorder;
+
 // Capture thread -> DSP thread. 8 frames = 66 ms at 120 Hz, more than the camera has buffers,
 // so the ring never holds the camera back in normal operation.
 using FrameRing = hal::SpscRing<hal::Frame, 8>;
@@ -84,6 +86,9 @@ class Engine {
          std::array<CommandRing*, 2> command_rings, SharedState& shared) noexcept;
 
   void start(std::int64_t now_ns) noexcept;
+  // --record: every processed instant also goes to the recorder (null: not recording). Set
+  // before the DSP thread starts.
+  void set_recorder(FrameRecorder* recorder) noexcept { recorder_ = recorder; }
   // One loop iteration at now_ns (CLOCK_MONOTONIC). Returns true when it did work (the caller
   // sleeps briefly when it did not).
   bool step(std::int64_t now_ns) noexcept;
@@ -154,6 +159,7 @@ class Engine {
   std::array<bool, 2> contact_{};
   std::array<bool, 2> slip_{};
   EngineStats stats_{};
+  FrameRecorder* recorder_ = nullptr;
 };
 
 // The dsp proxy a protocol mode maps to: AUTO is the pipeline's own kAuto when dsp has one,
