@@ -70,6 +70,15 @@ class RunTest : public ::testing::Test {
 
 }  // namespace
 
+// Wall-clock seconds the unpaced sim board runs: enough cycles for the grasp, the 30 deg turn and
+// the hold (about 300 at 120 Hz) even in the ASan+UBSan build, where the loop manages only ~20
+// cycles/s on a 2-core machine (the optimised build does several hundred).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr const char* kSimRunSeconds = "30";
+#else
+constexpr const char* kSimRunSeconds = "7";
+#endif
+
 TEST_F(RunTest, SimBoardStreamsAtTheSensorRateAndMatchesTheTruth) {
   // The shipped sim board with the frames taken as fast as the loop takes them (realtime off) and
   // stale/lost raised: this machine is shared, and a starved capture thread must not turn the
@@ -80,9 +89,10 @@ TEST_F(RunTest, SimBoardStreamsAtTheSensorRateAndMatchesTheTruth) {
   text.replace(text.find("lost_ms = 500"), 13, "lost_ms = 2000");
   std::ofstream(dir_ / "board.toml") << text;
   const fs::path log = dir_ / "bus.log";
-  const RunResult d = run_cmd(std::string(TACSE3D_BIN) + " --board " +
-                              (dir_ / "board.toml").string() + " --seconds 7 --calibration " +
-                              TACSE3_SIM_CALIBRATION + " --can-log " + log.string() + " 2>&1");
+  const RunResult d =
+      run_cmd(std::string(TACSE3D_BIN) + " --board " + (dir_ / "board.toml").string() +
+              " --seconds " + kSimRunSeconds + " --calibration " + TACSE3_SIM_CALIBRATION +
+              " --can-log " + log.string() + " 2>&1");
   ASSERT_EQ(d.status, 0) << d.out;
   // "... N cycles sent, ..." and "sim truth at the last cycle: rotation (x, y, z) deg" on stderr
   // (std::regex is avoided: GCC 12 warns inside it under the sanitizer build).
@@ -113,9 +123,10 @@ TEST_F(RunTest, SimBoardStreamsAtTheSensorRateAndMatchesTheTruth) {
   rows.erase(rows.begin());
   while (!rows.empty() && rows.back().empty()) rows.pop_back();
   EXPECT_EQ(rows.size(), sent) << "every cycle the daemon sent decodes in tacse3-canmon";
-  // The scenario (grasp, 30 deg turn, hold) is 240 frames; a loaded machine may get through
-  // fewer in 7 s, and the comparison below is with the truth at the last cycle's instant.
-  ASSERT_GE(rows.size(), 60u);
+  // The scenario (grasp, 30 deg turn, hold) is 240 frames: the comparison below is with the truth
+  // at the last cycle's instant, after the turn (mid-turn the smoothed estimate lags the truth).
+  ASSERT_GE(rows.size(), 240u) << "the loop did not get through the scenario in " << kSimRunSeconds
+                               << " s";
 
   // Cycle rate from the cycle timestamps.
   const double t0 = std::stod(split(rows.front(), ',')[0]);
