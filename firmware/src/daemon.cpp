@@ -215,6 +215,8 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
 #endif
       }
     }
+    d->backpressure_[s] = !board.sim.realtime && (sc.backend == CameraBackend::kSim ||
+                                                  sc.backend == CameraBackend::kReplay);
     const hal::CameraStatus st = d->cameras_[s]->open();
     if (!st.ok()) {
       *error = std::string("sensor ") + side + " (" + to_string(sc.backend) + " " + sc.device +
@@ -390,7 +392,12 @@ void Daemon::capture_loop(std::size_t s) {
         say(1, "sensor %s: streaming again", side);
       sh.disconnected.store(false, std::memory_order_release);
       reported_error = false;
-      if (!ring.push(f)) {
+      bool queued = ring.push(f);
+      while (!queued && backpressure_[s] && !stop_.load(std::memory_order_acquire)) {
+        sleep_ns(500'000);  // an unpaced source waits for the loop
+        queued = ring.push(f);
+      }
+      if (!queued) {
         // The DSP thread is behind by a whole ring: drop the newest, counted.
         cam.release(f);
         ++overflow;

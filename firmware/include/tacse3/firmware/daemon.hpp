@@ -96,6 +96,9 @@ class Daemon {
   std::shared_ptr<hal::SimRig> rig_;
   std::array<std::unique_ptr<hal::Camera>, 2> cameras_;
   std::array<hal::SimCamera*, 2> sim_cameras_{};
+  // Sources that are not paced to the wall clock (sim or replay with [sim] realtime = false)
+  // wait for ring space instead of dropping: nothing is lost when the loop is the slower side.
+  std::array<bool, 2> backpressure_{};
   std::unique_ptr<hal::can::Channel> channel_;
   std::unique_ptr<hal::GpioBackend> gpio_;
   std::unique_ptr<hal::GpioController> gpio_controller_;
