@@ -255,10 +255,15 @@ TEST_F(RunTest, ReplayBoardStreamsEveryFramePairOfARecording) {
 
 #if TACSE3_HAVE_RECORDER
 TEST_F(RunTest, RecordWritesTheProcessedPairsAsARecording) {
+  // The unpaced sim board: every instant is a pair, however slow the build.
+  std::string text = read_all(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml");
+  set_key(&text, "realtime", "false");
+  std::ofstream(dir_ / "board.toml") << text;
   const fs::path rec = dir_ / "recorded";
   const RunResult r =
-      run_cmd(std::string(TACSE3D_BIN) + " --board sim --seconds 1 --can-log " +
-              (dir_ / "can.log").string() + " --record " + rec.string() + " --verbose 2>&1");
+      run_cmd(std::string(TACSE3D_BIN) + " --board " + (dir_ / "board.toml").string() +
+              " --seconds " + seconds(2) + " --can-log " + (dir_ / "can.log").string() +
+              " --record " + rec.string() + " --verbose 2>&1");
   ASSERT_EQ(r.status, 0) << r.out;
   auto reader = tacse3::recording::RecordingReader::open(rec);
   ASSERT_TRUE(reader.ok()) << reader.status().message();
@@ -269,7 +274,7 @@ TEST_F(RunTest, RecordWritesTheProcessedPairsAsARecording) {
   ASSERT_NE(pairs_at, std::string::npos) << r.out;
   const std::size_t open_paren = r.out.rfind('(', pairs_at);
   const std::size_t pairs = std::stoul(r.out.substr(open_paren + 1, pairs_at - open_paren - 1));
-  EXPECT_GT(pairs, 20u);
+  EXPECT_GE(pairs, 10u);
   EXPECT_EQ(rd.frame_count(), pairs) << r.out;
   for (std::size_t i = 1; i < rd.frame_count(); ++i) {
     ASSERT_GT(rd.t_ns(i), rd.t_ns(i - 1));
