@@ -225,6 +225,9 @@ TEST_F(RunTest, ReplayBoardStreamsEveryFramePairOfARecording) {
   std::string text = read_all(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml");
   set_key(&text, "repeat", "false");  // play the recording once
   set_key(&text, "realtime", "false");
+  // A starved capture thread on a shared machine must not make a pad stale (single-pad cycles).
+  set_key(&text, "stale_ms", "1000");
+  set_key(&text, "lost_ms", "2000");
   for (std::size_t at = 0; (at = text.find("backend = \"sim\"", at)) != std::string::npos;) {
     const std::string repl = "backend = \"replay\"\ndevice = \"" + rec.string() + "\"";
     text.replace(at, std::string("backend = \"sim\"").size(), repl);
@@ -258,6 +261,8 @@ TEST_F(RunTest, RecordWritesTheProcessedPairsAsARecording) {
   // The unpaced sim board: every instant is a pair, however slow the build.
   std::string text = read_all(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml");
   set_key(&text, "realtime", "false");
+  set_key(&text, "stale_ms", "1000");
+  set_key(&text, "lost_ms", "2000");
   std::ofstream(dir_ / "board.toml") << text;
   const fs::path rec = dir_ / "recorded";
   const RunResult r =
@@ -275,7 +280,16 @@ TEST_F(RunTest, RecordWritesTheProcessedPairsAsARecording) {
   const std::size_t open_paren = r.out.rfind('(', pairs_at);
   const std::size_t pairs = std::stoul(r.out.substr(open_paren + 1, pairs_at - open_paren - 1));
   EXPECT_GE(pairs, 10u);
-  EXPECT_EQ(rd.frame_count(), pairs) << r.out;
+  // Every processed pair is either in the recording or counted as dropped: the ring is bounded,
+  // and an unpaced board can outrun the PNG writer on a loaded machine.
+  const std::size_t written_at = r.out.find(" frames written, ");
+  ASSERT_NE(written_at, std::string::npos) << r.out;
+  const std::size_t colon = r.out.rfind(": ", written_at);
+  const std::size_t written = std::stoul(r.out.substr(colon + 2, written_at - colon - 2));
+  const std::size_t dropped = std::stoul(r.out.substr(written_at + 17));
+  EXPECT_EQ(rd.frame_count(), written) << r.out;
+  EXPECT_EQ(written + dropped, pairs) << r.out;
+  EXPECT_GE(written, pairs / 2) << r.out;
   for (std::size_t i = 1; i < rd.frame_count(); ++i) {
     ASSERT_GT(rd.t_ns(i), rd.t_ns(i - 1));
   }
