@@ -19,6 +19,8 @@
 #include <sstream>
 #include <system_error>
 
+#include "tacse3/config/toml_names.hpp"
+
 namespace tacse3::firmware {
 
 const char* to_string(CameraBackend b) noexcept {
@@ -37,26 +39,9 @@ const char* to_string(CameraBackend b) noexcept {
 
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using config::type_name;
 
-std::string type_name(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::string:
-      return "a string";
-    case toml::node_type::integer:
-      return "an integer";
-    case toml::node_type::floating_point:
-      return "a float";
-    case toml::node_type::boolean:
-      return "a boolean";
-    case toml::node_type::array:
-      return "an array";
-    case toml::node_type::table:
-      return "a table";
-    default:
-      return "a date/time";
-  }
-}
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string num(double v) {
   std::ostringstream s;

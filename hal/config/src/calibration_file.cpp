@@ -22,6 +22,8 @@
 #include <sstream>
 #include <system_error>
 
+#include "tacse3/config/toml_names.hpp"
+
 namespace tacse3::config {
 namespace {
 
@@ -168,25 +170,6 @@ std::string where(const std::string& origin, const toml::node& n) {
   const auto& b = n.source().begin;
   if (b.line > 0) return origin + ":" + std::to_string(b.line) + ": ";
   return origin + ": ";
-}
-
-std::string type_name(const toml::node& n) {
-  switch (n.type()) {
-    case toml::node_type::string:
-      return "a string";
-    case toml::node_type::integer:
-      return "an integer";
-    case toml::node_type::floating_point:
-      return "a float";
-    case toml::node_type::boolean:
-      return "a boolean";
-    case toml::node_type::array:
-      return "an array";
-    case toml::node_type::table:
-      return "a table";
-    default:
-      return "a date/time";
-  }
 }
 
 // A real number: TOML float or integer.
@@ -733,6 +716,25 @@ Status save_calibration(const std::filesystem::path& file, const CalibrationSet&
     return {};
   } catch (...) {
     return Status::error(file.string() + ": unexpected error while writing");
+  }
+}
+
+std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a float";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::table:
+      return "a table";
+    default:
+      return "a date/time";
   }
 }
 
