@@ -223,6 +223,15 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
                "): " + st.message();
       return nullptr;
     }
+    const hal::CameraInfo& ci = d->cameras_[s]->info();
+    const bool cropped = ci.native_width > ci.width || ci.native_height > ci.height;
+    char rate[48] = "frame rate set by the pipeline";
+    if (ci.granted_fps() > 0.0)
+      std::snprintf(rate, sizeof(rate), "%.1f fps granted", ci.granted_fps());
+    d->say(1, "sensor %s: %s %s, %s %dx%d%s, %s, %d buffers", side, ci.backend.data(),
+           ci.card.data(), ci.fourcc.data(), cropped ? ci.native_width : ci.width,
+           cropped ? ci.native_height : ci.height,
+           cropped ? " centre-cropped to the configured size" : "", rate, ci.buffer_count);
   }
 
   // CAN channel.

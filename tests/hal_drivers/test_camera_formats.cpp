@@ -195,6 +195,74 @@ TEST(FrameView, RejectsBadBuffers) {
   EXPECT_EQ(v.data, nullptr);  // untouched on failure
 }
 
+// libcamera 0.0.3's vimc handler, as seen in the VM suite (daemon-libcamera): asked for 320x240 it
+// proposes 318x240; asked for 322 (320 + the 2 px shortfall) it grants 324, which covers 320 and is
+// centre-cropped by 2 columns on each side.
+TEST(CentreCrop, VimcGrantsAFewColumnsMore) {
+  const PixelSize want{320, 240};
+  const PixelSize next = next_size_request(want, want, PixelSize{318, 240});
+  EXPECT_EQ(next.width, 322);
+  EXPECT_EQ(next.height, 240);
+  // Covered: the request stays as it is, the negotiation ends.
+  const PixelSize same = next_size_request(want, next, PixelSize{324, 240});
+  EXPECT_EQ(same.width, 322);
+  EXPECT_EQ(same.height, 240);
+  const CropPlan plan = plan_centre_crop(PixelFormat::kRgb888, 320, 240, 324, 240, 972);
+  ASSERT_TRUE(plan.ok);
+  EXPECT_EQ(plan.x0, 2);
+  EXPECT_EQ(plan.y0, 0);
+  EXPECT_EQ(plan.byte_offset, 6u);  // 2 pixels x 3 bytes
+  // One spare column: it goes on the right (x0 = floor(1/2) = 0).
+  EXPECT_EQ(plan_centre_crop(PixelFormat::kRgb888, 320, 240, 321, 240, 0).byte_offset, 0u);
+}
+
+TEST(CentreCrop, BinnedSensorModeOffsetsByRowsAndPixels) {
+  // 328x246 BGR888 in 1024-byte rows: 4 columns and 3 rows go on the left/top.
+  const CropPlan rgb = plan_centre_crop(PixelFormat::kRgb888, 320, 240, 328, 246, 1024);
+  ASSERT_TRUE(rgb.ok);
+  EXPECT_EQ(rgb.x0, 4);
+  EXPECT_EQ(rgb.y0, 3);
+  EXPECT_EQ(rgb.byte_offset, 3u * 1024u + 4u * 3u);
+  // YUYV keeps whole macropixels: 6 spare columns would put x0 at 3, it goes to 2.
+  const CropPlan yuyv = plan_centre_crop(PixelFormat::kYuyv, 320, 240, 326, 240, 0);
+  ASSERT_TRUE(yuyv.ok);
+  EXPECT_EQ(yuyv.x0, 2);
+  EXPECT_EQ(yuyv.byte_offset, 2u * 2u);
+  const CropPlan grey = plan_centre_crop(PixelFormat::kGrey, 320, 240, 322, 244, 384);
+  ASSERT_TRUE(grey.ok);
+  EXPECT_EQ(grey.byte_offset, 2u * 384u + 1u);
+}
+
+TEST(CentreCrop, TheCroppedViewSeesTheCentrePixels) {
+  // A 322x242 GREY frame whose pixel (x, y) holds (x + 3 * y) mod 256; the 320x240 view must start
+  // at delivered pixel (1, 1) and keep the delivered stride.
+  const int gw = 322, gh = 242;
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(gw * gh));
+  for (int y = 0; y < gh; ++y)
+    for (int x = 0; x < gw; ++x)
+      buf[static_cast<std::size_t>(y * gw + x)] = static_cast<std::uint8_t>(x + 3 * y);
+  const CropPlan plan = plan_centre_crop(PixelFormat::kGrey, 320, 240, gw, gh, gw);
+  ASSERT_TRUE(plan.ok);
+  dsp::FrameView v;
+  ASSERT_TRUE(make_frame_view(PixelFormat::kGrey, buf.data() + plan.byte_offset,
+                              buf.size() - plan.byte_offset, 320, 240, gw, v)
+                  .ok());
+  EXPECT_EQ(v.data[0], 1 + 3 * 1);
+  EXPECT_EQ(v.data[static_cast<std::size_t>(239 * gw + 319)],
+            static_cast<std::uint8_t>(320 + 3 * 240));
+}
+
+TEST(CentreCrop, RefusesSmallerOrFarLargerModes) {
+  EXPECT_FALSE(plan_centre_crop(PixelFormat::kRgb888, 320, 240, 318, 240, 0).ok);
+  EXPECT_FALSE(plan_centre_crop(PixelFormat::kRgb888, 320, 240, 320, 239, 0).ok);
+  EXPECT_TRUE(plan_centre_crop(PixelFormat::kRgb888, 320, 240, 320 + kMaxCropPixels, 240, 0).ok);
+  EXPECT_FALSE(
+      plan_centre_crop(PixelFormat::kRgb888, 320, 240, 320 + kMaxCropPixels + 1, 240, 0).ok);
+  EXPECT_FALSE(plan_centre_crop(PixelFormat::kRgb888, 320, 240, 640, 480, 0).ok);
+  EXPECT_FALSE(plan_centre_crop(PixelFormat::kGrey, 320, 240, 324, 240, 200).ok);  // stride < row
+  EXPECT_FALSE(plan_centre_crop(PixelFormat::kYuyv, 320, 240, 321, 240, 0).ok);    // odd YUYV
+}
+
 TEST(CameraConfig, ValidateNamesTheField) {
   CameraConfig c;
   c.device = "/dev/video0";

@@ -161,6 +161,7 @@ class LibcameraCamera final : public Camera {
   bool running_ = false;
   dsp::PixelFormat format_ = dsp::PixelFormat::kGrey;
   int stride_ = 0;
+  std::size_t crop_offset_ = 0;  // bytes from the buffer start to the kept 320x240 window
   std::int64_t next_retry_ns_ = 0;
   int wake_fd_ = -1;
   std::atomic<bool> lost_{false};
@@ -250,18 +251,38 @@ CameraStatus LibcameraCamera::acquire_and_configure() {
                                name(), count);
   }
   sc.pixelFormat = lc::PixelFormat(choice.fourcc);
-  sc.size = lc::Size(static_cast<unsigned int>(cfg_.width), static_cast<unsigned int>(cfg_.height));
   sc.bufferCount = static_cast<unsigned int>(cfg_.buffer_count);
-  const lc::CameraConfiguration::Status vs = configuration_->validate();
+  // Ask for the configured size; when the pipeline can only grant a smaller one (vimc proposes
+  // 318 for 320), ask again for a bit more, and centre-crop a slightly larger grant.
+  const PixelSize want{cfg_.width, cfg_.height};
+  PixelSize asked = want;
+  lc::CameraConfiguration::Status vs = lc::CameraConfiguration::Invalid;
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    sc.pixelFormat = lc::PixelFormat(choice.fourcc);
+    sc.size =
+        lc::Size(static_cast<unsigned int>(asked.width), static_cast<unsigned int>(asked.height));
+    vs = configuration_->validate();
+    const PixelSize got{static_cast<int>(sc.size.width), static_cast<int>(sc.size.height)};
+    const PixelSize next = next_size_request(want, asked, got);
+    if (vs == lc::CameraConfiguration::Invalid || sc.pixelFormat.fourcc() != choice.fourcc ||
+        (next.width == asked.width && next.height == asked.height)) {
+      break;
+    }
+    asked = next;
+  }
+  const int got_w = static_cast<int>(sc.size.width);
+  const int got_h = static_cast<int>(sc.size.height);
+  const CropPlan crop = plan_centre_crop(choice.output, cfg_.width, cfg_.height, got_w, got_h,
+                                         static_cast<int>(sc.stride));
   if (vs == lc::CameraConfiguration::Invalid || sc.pixelFormat.fourcc() != choice.fourcc ||
-      sc.size.width != static_cast<unsigned int>(cfg_.width) ||
-      sc.size.height != static_cast<unsigned int>(cfg_.height)) {
+      !crop.ok) {
     return CameraStatus::error(CameraError::kNotSupported,
                                "libcamera camera %s: %s %dx%d not accepted (pipeline proposes %s "
-                               "%ux%u)",
+                               "%ux%u; a larger mode is centre-cropped by at most %d px per "
+                               "dimension)",
                                name(), fourcc_string(choice.fourcc).data(), cfg_.width, cfg_.height,
                                fourcc_string(sc.pixelFormat.fourcc()).data(), sc.size.width,
-                               sc.size.height);
+                               sc.size.height, kMaxCropPixels);
   }
   r = camera_->configure(configuration_.get());
   if (r < 0) {
@@ -271,6 +292,17 @@ CameraStatus LibcameraCamera::acquire_and_configure() {
   stream_ = sc.stream();
   format_ = choice.output;
   stride_ = static_cast<int>(sc.stride);
+  // The crop again with the stride configure() settled on (validate() may not have set it).
+  const CropPlan final_crop =
+      plan_centre_crop(format_, cfg_.width, cfg_.height, got_w, got_h, stride_);
+  if (!final_crop.ok) {
+    return CameraStatus::error(
+        CameraError::kNotSupported,
+        "libcamera camera %s: configured %dx%d with %d-byte rows cannot hold a "
+        "%dx%d window",
+        name(), got_w, got_h, stride_, cfg_.width, cfg_.height);
+  }
+  crop_offset_ = final_crop.byte_offset;
 
   allocator_ = std::make_unique<lc::FrameBufferAllocator>(camera_);
   r = allocator_->allocate(stream_);
@@ -321,6 +353,8 @@ CameraStatus LibcameraCamera::acquire_and_configure() {
   info_.format = format_;
   info_.width = cfg_.width;
   info_.height = cfg_.height;
+  info_.native_width = got_w;
+  info_.native_height = got_h;
   info_.stride_bytes = stride_;
   info_.buffer_count = nslots_;
   info_.decoded = false;
@@ -548,7 +582,12 @@ CameraStatus LibcameraCamera::next_frame(Frame& frame, int timeout_ms) {
     } else {
       std::size_t bytes = slot.length;
       if (!md.planes().empty()) bytes = std::min<std::size_t>(bytes, md.planes()[0].bytesused);
-      st = make_frame_view(format_, slot.data, bytes, cfg_.width, cfg_.height, stride_, view);
+      st = bytes <= crop_offset_
+               ? CameraStatus::error(CameraError::kCorruptFrame,
+                                     "libcamera camera %s: frame %u holds %zu bytes", name(),
+                                     md.sequence, bytes)
+               : make_frame_view(format_, slot.data + crop_offset_, bytes - crop_offset_,
+                                 cfg_.width, cfg_.height, stride_, view);
     }
     if (!st.ok()) {
       bump(counters_.corrupt);

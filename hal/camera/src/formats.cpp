@@ -2,6 +2,7 @@
 // tacse3 hal: pixel format codes, format negotiation choices and raw-buffer -> FrameView checks.
 #include "tacse3/hal/camera/formats.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace tacse3::hal {
@@ -175,6 +176,33 @@ CameraStatus make_frame_view(dsp::PixelFormat format, const std::uint8_t* data, 
   out.stride_bytes = stride;
   out.format = format;
   return CameraStatus::success();
+}
+
+CropPlan plan_centre_crop(dsp::PixelFormat format, int want_w, int want_h, int got_w, int got_h,
+                          int stride_bytes) noexcept {
+  CropPlan plan;
+  if (want_w <= 0 || want_h <= 0 || got_w < want_w || got_h < want_h) return plan;
+  if (got_w - want_w > kMaxCropPixels || got_h - want_h > kMaxCropPixels) return plan;
+  if (format == dsp::PixelFormat::kYuyv && (want_w % 2 != 0 || got_w % 2 != 0)) return plan;
+  const int row = packed_row_bytes(format, got_w);
+  if (row <= 0) return plan;
+  const int stride = stride_bytes == 0 ? row : stride_bytes;
+  if (stride < row) return plan;
+  plan.x0 = (got_w - want_w) / 2;
+  plan.y0 = (got_h - want_h) / 2;
+  if (format == dsp::PixelFormat::kYuyv) plan.x0 &= ~1;  // a Y0 U Y1 V macropixel is not split
+  const int bytes_per_pixel = packed_row_bytes(format, 2) / 2;
+  plan.byte_offset = static_cast<std::size_t>(plan.y0) * static_cast<std::size_t>(stride) +
+                     static_cast<std::size_t>(plan.x0) * static_cast<std::size_t>(bytes_per_pixel);
+  plan.ok = true;
+  return plan;
+}
+
+PixelSize next_size_request(PixelSize want, PixelSize asked, PixelSize got) noexcept {
+  PixelSize next = asked;
+  if (got.width < want.width) next.width += std::max(1, want.width - got.width);
+  if (got.height < want.height) next.height += std::max(1, want.height - got.height);
+  return next;
 }
 
 }  // namespace tacse3::hal

@@ -97,8 +97,10 @@ struct CameraInfo {
   std::array<char, 64> card{};     // device/camera name
   std::array<char, 8> fourcc{};    // the device's native format, e.g. "YUYV", "MJPG"
   dsp::PixelFormat format = dsp::PixelFormat::kGrey;  // what frames carry
-  int width = 0;
+  int width = 0;                                      // what frames carry
   int height = 0;
+  int native_width = 0;   // what the device delivers: larger when the backend
+  int native_height = 0;  // centre-crops (libcamera); 0 = the same as width/height
   int stride_bytes = 0;
   int buffer_count = 0;
   bool decoded = false;            // MJPEG decoded by the backend

@@ -95,6 +95,37 @@ struct LibcameraFormatChoice {
 LibcameraFormatChoice choose_libcamera_format(const std::uint32_t* fourccs,
                                               std::size_t count) noexcept;
 
+// Centre crop of a larger delivered mode down to the configured size. Some pipelines cannot
+// produce every size: libcamera 0.0.3's vimc handler proposes 318 for 320 and
+// grants 324 for 322, and a
+// CSI sensor may have a 328x246 binned mode and no 320x240 one. Cropping keeps the pixel pitch
+// (a scaled mode would not), so the calibration stays valid; the pad centre stays the image
+// centre. The crop is bounded so a wildly different mode (a smaller field of view the user did
+// not ask for) is still refused.
+inline constexpr int kMaxCropPixels = 32;  // per dimension, both sides together
+
+struct CropPlan {
+  bool ok = false;
+  int x0 = 0;                   // first delivered column kept (even for YUYV: whole macropixels)
+  int y0 = 0;                   // first delivered row kept
+  std::size_t byte_offset = 0;  // of pixel (x0, y0) from the buffer start: y0 * stride + x0 * bpp
+};
+
+// The crop that takes `want_w` x `want_h` from the centre of a delivered `got_w` x `got_h` frame
+// with rows of `stride_bytes`. !ok when the delivered mode is smaller than wanted in either
+// dimension, exceeds it by more than kMaxCropPixels, or the geometry is invalid.
+CropPlan plan_centre_crop(dsp::PixelFormat format, int want_w, int want_h, int got_w, int got_h,
+                          int stride_bytes) noexcept;
+
+// The next size to ask a pipeline for after it adjusted `asked` to `got`, so that the grant
+// ends up at least `want`: each dimension that came back short grows by its shortfall (at least
+// 1 px). Returns `asked` unchanged when `got` already covers `want`.
+struct PixelSize {
+  int width = 0;
+  int height = 0;
+};
+PixelSize next_size_request(PixelSize want, PixelSize asked, PixelSize got) noexcept;
+
 // Bytes in one tightly packed row of `format` at `width` (YUYV: width must be even).
 int packed_row_bytes(dsp::PixelFormat format, int width) noexcept;
 
