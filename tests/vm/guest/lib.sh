@@ -242,12 +242,14 @@ daemon_stop_timed() {
 # USB unplug: the node stays but every ioctl, and open(), fails with ENODEV, and the instance comes
 # back by itself once the last open file of it is closed. This shell keeps one open (fd 7) so the
 # sensor stays away until vivid_replug closes it, whatever the daemon does meanwhile. Markers on
-# vcan0: 01 just before the unplug, 02 when the node opens again.
+# vcan0: 01 just before the unplug, 0A once v4l2-ctl has returned (it takes a few hundred ms to start
+# under TCG, so the disconnect lies between the two), 02 when the node opens again.
 vivid_unplug() {
   _node=$(vivid_node "$1")
   exec 7<"$_node"
   can_marker 01
   v4l2-ctl -d "$_node" -c disconnect=1 || fail "vivid-00$1 disconnect"
+  can_marker 0A
 }
 vivid_replug() {
   exec 7<&-
