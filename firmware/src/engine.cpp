@@ -432,7 +432,12 @@ bool Engine::step(std::int64_t now_ns) noexcept {
     worked = true;
   }
 
-  for (int guard = 0; guard < 16; ++guard) {
+  // At most one processed cycle per step: the caller comes straight back with a fresh clock, so
+  // the 10 Hz Status below is never starved by a backlog of frames (a slow core working through
+  // 16 queued cycles at 60 ms each would otherwise hold it back for a second). Late-frame drops
+  // are cheap and keep looping.
+  bool processed = false;
+  for (int guard = 0; guard < 16 && !processed; ++guard) {
     refill_heads(now_ns);
     update_state(now_ns);
     // While booting, a configured sensor that has not delivered yet (and is not known lost) is
@@ -452,12 +457,15 @@ bool Engine::step(std::int64_t now_ns) noexcept {
     switch (a) {
       case PairAction::kPair:
         process(true, true, now_ns);
+        processed = true;
         break;
       case PairAction::kLeftAlone:
         process(true, false, now_ns);
+        processed = true;
         break;
       case PairAction::kRightAlone:
         process(false, true, now_ns);
+        processed = true;
         break;
       case PairAction::kDropLeft:
       case PairAction::kDropRight: {

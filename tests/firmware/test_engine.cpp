@@ -299,6 +299,31 @@ TEST_F(EngineTest, BothSensorsLostIsAFault) {
   EXPECT_LE(engine_->stats().status_groups, groups + 10);
 }
 
+// A slow core with a backlog of frames must not hold the 10 Hz Status back: one step processes
+// at most one cycle, then the Status check runs.
+TEST_F(EngineTest, BacklogDoesNotStarveTheStatus) {
+  for (std::size_t i = 0; i < 20; ++i) tick(i);
+  for (std::size_t i = 20; i < 26; ++i) {  // six pairs queued, nobody stepping
+    for (std::size_t s = 0; s < 2; ++s) {
+      hal::Frame f;
+      const auto& img = (*frames_)[2 * (i % frame_count()) + s];
+      f.view = {img.data(), img.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+      f.timestamp_ns = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
+      f.sequence = static_cast<std::uint32_t>(i);
+      ASSERT_TRUE(rings_[s].push(f));
+    }
+  }
+  const std::uint64_t samples = engine_->stats().samples;
+  const std::uint64_t groups = engine_->stats().status_groups;
+  const std::int64_t late = now_ + 250'000'000;  // a Status is due
+  ASSERT_TRUE(engine_->step(late));
+  EXPECT_EQ(engine_->stats().samples, samples + 1);
+  EXPECT_EQ(engine_->stats().status_groups, groups + 1);
+  for (int k = 1; k <= 5; ++k) ASSERT_TRUE(engine_->step(late + k));
+  EXPECT_EQ(engine_->stats().samples, samples + 6);
+  EXPECT_FALSE(engine_->step(late + 10));  // drained: nothing left to do
+}
+
 TEST_F(EngineTest, LoopDoesNotAllocate) {
   for (std::size_t i = 0; i < 30; ++i) tick(i);  // warm-up: first status, first cycle
   protocol::Command tare;
