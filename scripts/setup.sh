@@ -29,6 +29,10 @@ PACKAGES=(
   # protocol cross-checks: python-can example and the independent DBC decoder (npm)
   python3 python3-can
 )
+# The real-driver VM suite (tests/vm): qemu-system, kmod, the module build tools. Its guest kernels
+# and userland are fetched at test time with apt-get download into build/vm/.
+mapfile -t VM_PACKAGES < <(tests/vm/setup-host.sh --print)
+PACKAGES+=("${VM_PACKAGES[@]}")
 
 # A Debian mirror mid-sync can serve one index with the wrong size (seen: the armhf security list).
 # Retry with a pause; if one list still fails, continue with what apt has: the install below then

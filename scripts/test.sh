@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # tacse3: the test command. Builds and runs the host tests, the ASan+UBSan build and the aarch64
-# build under qemu-user, then builds and checks the arm64/armhf .deb packages and runs the bounded
-# protocol fuzzers. Exits non-zero on any failure.
+# build under qemu-user, then builds and checks the arm64/armhf .deb packages, runs the bounded
+# protocol fuzzers and the real-driver VM suite (tests/vm: SocketCAN, V4L2, libcamera, GPIO in
+# qemu-system guests). Exits non-zero on any failure.
+# Skips: TACSE3_SKIP_PACKAGE=1, TACSE3_SKIP_FUZZ=1, TACSE3_SKIP_VM=1.
 # Usage: scripts/test.sh [preset ...]      (default: host host-sanitize aarch64)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,6 +34,13 @@ if [ -x fuzz/run.sh ] && [ "${TACSE3_SKIP_FUZZ:-0}" != "1" ]; then
   echo "=== protocol fuzzers (bounded) ==="
   fuzz/run.sh "${TACSE3_FUZZ_SECONDS:-60}"
   summary+=("fuzz: ok")
+fi
+
+# Needs the host and aarch64 builds (the suite builds its few targets there if a preset was skipped).
+if [ "${TACSE3_SKIP_VM:-0}" != "1" ]; then
+  echo "=== real-driver VM suite (tests/vm, qemu TCG) ==="
+  TACSE3_VM_REQUIRE_DAEMON=1 tests/vm/suite.sh
+  summary+=("vm: ok")
 fi
 
 echo "=== summary ==="
