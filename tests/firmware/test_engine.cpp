@@ -91,6 +91,13 @@ class EngineTest : public ::testing::Test {
   // Pushes frame i of the sensors asked for (timestamped on the 120 Hz grid), then runs one loop
   // iteration one period later.
   void tick(std::size_t i, bool left = true, bool right = true) {
+    push(i, left, right);
+    now_ = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod + 500'000;
+    engine_->step(now_);
+  }
+
+  // Queues frame i of the sensors asked for, without running the loop.
+  void push(std::size_t i, bool left = true, bool right = true) {
     for (std::size_t s = 0; s < 2; ++s) {
       if (!(s == 0 ? left : right)) continue;
       hal::Frame f;
@@ -100,8 +107,6 @@ class EngineTest : public ::testing::Test {
       f.sequence = static_cast<std::uint32_t>(i);
       ASSERT_TRUE(rings_[s].push(f));
     }
-    now_ = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod + 500'000;
-    engine_->step(now_);
   }
 
   void command(const protocol::Command& c) {
@@ -303,16 +308,7 @@ TEST_F(EngineTest, BothSensorsLostIsAFault) {
 // at most one cycle, then the Status check runs.
 TEST_F(EngineTest, BacklogDoesNotStarveTheStatus) {
   for (std::size_t i = 0; i < 20; ++i) tick(i);
-  for (std::size_t i = 20; i < 26; ++i) {  // six pairs queued, nobody stepping
-    for (std::size_t s = 0; s < 2; ++s) {
-      hal::Frame f;
-      const auto& img = (*frames_)[2 * (i % frame_count()) + s];
-      f.view = {img.data(), img.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
-      f.timestamp_ns = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
-      f.sequence = static_cast<std::uint32_t>(i);
-      ASSERT_TRUE(rings_[s].push(f));
-    }
-  }
+  for (std::size_t i = 20; i < 26; ++i) push(i);  // six pairs queued, nobody stepping
   const std::uint64_t samples = engine_->stats().samples;
   const std::uint64_t groups = engine_->stats().status_groups;
   const std::int64_t late = now_ + 250'000'000;  // a Status is due
