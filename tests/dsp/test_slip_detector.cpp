@@ -280,5 +280,54 @@ TEST(SlipDetector, ContactLossRestartsSticking) {
   EXPECT_FALSE(m.slipping);
 }
 
+// The decision-locked reference (dsp_ref::SlipDecision, used only to report a second fixed−ref
+// figure): following the fixed pipeline's decisions reproduces them frame by frame, also when
+// the reference's own detector would decide differently (here: a delayed onset imposed on it).
+TEST(SlipDetector, DecisionLockedReferenceFollowsTheGivenDecisions) {
+  const Disc disc;
+  const Calibration cal = auto_cal();
+  std::vector<double> theta;
+  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
+  for (int k = 0; k <= 120; ++k) theta.push_back(kDragS * 30.0 * kDeg * min_jerk_rate(k / 120.0));
+  for (int k = 0; k < 60; ++k) theta.push_back(0.0);
+  auto a = std::make_unique<MotionEstimator>();
+  ASSERT_EQ(a->configure(cal), Status::kOk);
+  dsp_ref::MotionRef free_ref(cal), locked(cal), delayed(cal);
+  auto sh = std::make_unique<VectorField>();
+  std::vector<double> sx, sy;
+  std::vector<dsp_ref::SlipDecision> fixed_decisions;
+  int onset_frame = -1;
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    disc.shear(theta[k], 0.0, cal.c_displacement, *sh, sx, sy);
+    SensorMotion ma;
+    ASSERT_EQ(a->update(*disc.cs, *sh, kDt, ma), Status::kOk);
+    const dsp_ref::SlipDecision d{ma.slipping, ma.stick_confirmed};
+    fixed_decisions.push_back(d);
+    if (ma.slip_onset && onset_frame < 0) onset_frame = static_cast<int>(k);
+    const dsp_ref::SensorMotionRef mf = free_ref.update(disc.ref, sx, sy, kDt);
+    const dsp_ref::SensorMotionRef ml = locked.update(disc.ref, sx, sy, kDt, &d);
+    // The free reference takes the same decisions here, so locking changes nothing.
+    ASSERT_EQ(ml.slipping, ma.slipping) << "frame " << k;
+    ASSERT_EQ(mf.slipping, ma.slipping) << "frame " << k;
+    ASSERT_NEAR(ml.omega.z(), mf.omega.z(), 1e-12 + 1e-12 * std::abs(mf.omega.z()))
+        << "frame " << k;
+  }
+  ASSERT_GT(onset_frame, 0);
+  // Impose an onset 5 frames late: the locked reference follows it (and pays back the deficit
+  // from then on), so its integrated rotation still reaches the velocity proxy's.
+  std::vector<dsp_ref::SlipDecision> late = fixed_decisions;
+  for (int k = onset_frame + 1; k <= onset_frame + 5; ++k) {
+    late[static_cast<std::size_t>(k)].slipping = false;
+  }
+  double total = 0.0;
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    disc.shear(theta[k], 0.0, cal.c_displacement, *sh, sx, sy);
+    const dsp_ref::SensorMotionRef m = delayed.update(disc.ref, sx, sy, kDt, &late[k]);
+    ASSERT_EQ(m.slipping, late[k].slipping) << "frame " << k;
+    total += m.omega.z() * kDt;
+  }
+  EXPECT_NEAR(total, 30.0 * kDeg, 0.5 * kDeg);
+}
+
 }  // namespace
 }  // namespace tacse3::dsp

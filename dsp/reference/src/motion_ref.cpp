@@ -97,10 +97,23 @@ void MotionRef::reset() {
 }
 
 SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<double>& shear_x,
-                                  const std::vector<double>& shear_y, double dt) {
+                                  const std::vector<double>& shear_y, double dt,
+                                  const SlipDecision* follow) {
   const auto n = static_cast<std::size_t>(dsp::kGridCount);
   const bool automatic = cal_.velocity_proxy == dsp::VelocityProxy::kAuto;
+  if (!automatic) follow = nullptr;
   SensorMotionRef out;
+  if (follow != nullptr && follow->slipping != slipping_) {
+    // The followed detector switched at the end of the previous frame: onset (start paying back
+    // over slip_catchup_frames) or exit (the detector restarts, as dsp::MotionEstimator does).
+    if (follow->slipping) {
+      slipping_ = true;
+      evidence_frames_ = 0;
+      catchup_left_ = cal_.slip_catchup_frames;
+    } else {
+      reset_detector();
+    }
+  }
   // kAuto bookkeeping with the state of the previous frames (dsp::MotionEstimator's rules).
   const bool accumulate = automatic && !slipping_ && have_prev_shear_;
   const int left = automatic && slipping_ ? catchup_left_ : 0;
@@ -186,7 +199,15 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       out.shear_rate_m_s = change.norm() / dt;
       out.slip_relax_rate = x2 > 0.0 ? -content_.dot(change) / (x2 * dt) : 0.0;
       const bool rest = out.shear_rate_m_s < cal_.stick_rest_speed_m_s;
-      if (!slipping_) {
+      if (follow != nullptr) {
+        // Transitions come from the followed decisions (next frame's `slipping`).
+        if (!slipping_ && follow->stick_confirmed) {
+          out.stick_confirmed = true;
+          std::fill(deficit_x_.begin(), deficit_x_.end(), 0.0);
+          std::fill(deficit_y_.begin(), deficit_y_.end(), 0.0);
+          deficit_t_.setZero();
+        }
+      } else if (!slipping_) {
         const bool relaxing = out.shear_shift_m > cal_.slip_min_shift_m &&
                               out.slip_relax_rate > cal_.slip_relax_rate_on;
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;

@@ -10,13 +10,16 @@
 
 namespace tacse3::dsp_ref {
 
-SensorPipelineRef::SensorPipelineRef(const dsp::PipelineConfig& config, const dsp::Calibration& cal)
+SensorPipelineRef::SensorPipelineRef(const dsp::PipelineConfig& config, const dsp::Calibration& cal,
+                                     const ReferenceOptions& options)
     : config_(config),
       cal_(cal),
       flow_stage_(config.flow),
       nhhd_stage_(config.nhhd),
       contact_stage_(cal),
-      motion_stage_(cal) {}
+      motion_stage_(cal) {
+  flow_stage_.set_fixed_point_sampling(options.fixed_point_sampling);
+}
 
 void SensorPipelineRef::tare() {
   if (flow_stage_.has_reference()) {
@@ -31,8 +34,9 @@ void SensorPipelineRef::tare() {
 }
 
 bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, SensorMotionRef& out,
-                                bool& degraded) {
+                                bool& degraded, const SlipDecision* follow) {
   out = SensorMotionRef{};
+  motion_ = SensorMotionRef{};
   degraded = false;
   // The luma stage is exact integer arithmetic (test_luma holds it against luma_ref), so the
   // reference starts from the same working image.
@@ -63,7 +67,8 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
   fz_ = forces.fz;
   shear_x_ = forces.fx;
   shear_y_ = forces.fy;
-  const ContactSetRef contact = contact_stage_.detect(fz_, grid_vector_to_q16(smoothed_), mask_q);
+  contact_ = contact_stage_.detect(fz_, grid_vector_to_q16(smoothed_), mask_q);
+  const ContactSetRef& contact = contact_;
 
   const int min_tracked = static_cast<int>(
       std::ceil(config_.min_tracked_fraction * static_cast<double>(dsp::kGridCount)));
@@ -73,19 +78,22 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
     return true;
   }
   const double dt = (std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= 1.0) ? dt_s : 1.0 / 120.0;
-  out = motion_stage_.update(contact, shear_x_, shear_y_, dt);
+  out = motion_stage_.update(contact, shear_x_, shear_y_, dt, follow);
+  motion_ = out;
   return true;
 }
 
 DualPipelineRef::DualPipelineRef(const dsp::DualConfig& config,
-                                 const std::array<dsp::Calibration, 2>& cal)
+                                 const std::array<dsp::Calibration, 2>& cal,
+                                 const ReferenceOptions& options)
     : config_(config), cal_(cal) {
-  sensors_.emplace_back(config.pipeline, cal[0]);
-  sensors_.emplace_back(config.pipeline, cal[1]);
+  sensors_.emplace_back(config.pipeline, cal[0], options);
+  sensors_.emplace_back(config.pipeline, cal[1], options);
 }
 
 void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* right,
-                              std::int64_t t_ns, DualResultRef& out) {
+                              std::int64_t t_ns, DualResultRef& out,
+                              const std::array<SlipDecision, 2>* follow) {
   out = DualResultRef{};
   double dt = config_.nominal_frame_period_s;
   if (have_last_t_ && t_ns > last_t_ns_) {
@@ -101,8 +109,9 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
   for (int i = 0; i < 2; ++i) {
     if (frames[i] == nullptr) continue;
     bool degraded = false;
-    if (sensors_[static_cast<std::size_t>(i)].process(*frames[i], dt, m[static_cast<std::size_t>(i)],
-                                                      degraded)) {
+    const SlipDecision* f = follow != nullptr ? &(*follow)[static_cast<std::size_t>(i)] : nullptr;
+    if (sensors_[static_cast<std::size_t>(i)].process(
+            *frames[i], dt, m[static_cast<std::size_t>(i)], degraded, f)) {
       ok[static_cast<std::size_t>(i)] = !degraded;
     }
   }

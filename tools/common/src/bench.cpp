@@ -77,9 +77,9 @@ std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
   const SourceInfo& info = src->info();
   struct Runner {
     Replayer engine;
-    std::unique_ptr<dsp_ref::DualPipelineRef> ref;
+    std::unique_ptr<dsp_ref::DualPipelineRef> ref, locked;
     std::vector<dsp::Pose> poses;
-    std::vector<dsp::Pose> ref_poses;
+    std::vector<dsp::Pose> ref_poses, locked_poses;
     std::vector<FrameResult> rows;
   };
   std::vector<std::unique_ptr<Runner>> runners;
@@ -94,6 +94,10 @@ std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
     if (ec.reference) {
       r->ref =
           std::make_unique<dsp_ref::DualPipelineRef>(r->engine.setup().dual, r->engine.setup().cal);
+      if (ec.mode == ProxyMode::kAuto) {
+        r->locked = std::make_unique<dsp_ref::DualPipelineRef>(r->engine.setup().dual,
+                                                               r->engine.setup().cal);
+      }
     }
     runners.push_back(std::move(r));
   }
@@ -112,6 +116,17 @@ std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
                         ref_out);
         r->ref_poses.push_back(ref_out.pose);
       }
+      if (r->locked) {
+        const auto& use = r->engine.setup().use;
+        std::array<dsp_ref::SlipDecision, 2> follow{};
+        for (std::size_t s = 0; s < 2; ++s) {
+          follow[s].slipping = r->engine.result().sensors[s].motion.slipping;
+          follow[s].stick_confirmed = r->engine.result().sensors[s].motion.stick_confirmed;
+        }
+        r->locked->process(use[0] ? views[0] : nullptr, use[1] ? views[1] : nullptr, info.t_ns[i],
+                           ref_out, &follow);
+        r->locked_poses.push_back(ref_out.pose);
+      }
     }
     if (frames_done != nullptr) ++*frames_done;
   }
@@ -125,6 +140,10 @@ std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
       e.reference_error_deg = re.final_rotation_error_deg;
       e.reference_translation_error_mm = re.final_translation_error_mm;
       e.fixed_vs_reference_deg = rotation_error_deg(r.poses.back().q, r.ref_poses.back().q);
+    }
+    if (r.locked) {
+      e.fixed_vs_locked_reference_deg =
+          rotation_error_deg(r.poses.back().q, r.locked_poses.back().q);
     }
     const RunSummary s = summarize(info, r.rows, configs[k].sensors);
     e.slip = s.slip;

@@ -55,14 +55,26 @@ struct SensorMotionRef {
   double shear_rate_m_s = 0.0;
 };
 
+// A stick/slip decision to follow (kAuto only), taken from the fixed-point pipeline's
+// dsp::SensorMotion of the same frame: `slipping` is the proxy that frame used, `stick_confirmed`
+// whether it dropped the deficit. Used ONLY to measure the numeric fixed−ref difference with the
+// detector's threshold crossings taken out ("decision-locked"; docs/dsp.md).
+struct SlipDecision {
+  bool slipping = false;
+  bool stick_confirmed = false;
+};
+
 // Same rules as dsp::MotionEstimator (translation sources, proxy modes, λ), in double.
 class MotionRef {
  public:
   explicit MotionRef(const dsp::Calibration& cal = {});
   void reset();
   // shear_x/shear_y: calibrated shear (shear units, real values) per grid point.
+  // follow (kAuto only, may be null): take the stick/slip transitions from this decision instead
+  // of the reference's own detector (whose features are still computed and reported).
   SensorMotionRef update(const ContactSetRef& c, const std::vector<double>& shear_x,
-                         const std::vector<double>& shear_y, double dt);
+                         const std::vector<double>& shear_y, double dt,
+                         const SlipDecision* follow = nullptr);
 
  private:
   dsp::Calibration cal_;

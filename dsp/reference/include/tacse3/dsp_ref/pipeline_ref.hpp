@@ -15,16 +15,31 @@
 
 namespace tacse3::dsp_ref {
 
+// How the reference chain is run (docs/dsp.md, "Fixed point vs the double reference").
+struct ReferenceOptions {
+  // Block flow on the fixed-point path's sampling grid (BlockFlowRef::set_fixed_point_sampling):
+  // positions rounded to 1/32 px, the step added to the rounded position, stop when the rounded
+  // position repeats. Off (default): exact positions, |step| < 1/64 px, i.e. the converged LK
+  // solution of Eq. (dense_flow), which the fixed path approximates to second order. On is a
+  // diagnostic: its discrete stopping rule makes the two chains take different iteration counts
+  // where the double arithmetic rounds a position differently (measured: better agreement on
+  // some simulated recordings, worse on the synthetic scenes of test_pipeline).
+  bool fixed_point_sampling = false;
+};
+
 // One sensor's reference chain: luma → block flow → smoothing → 𝒢 → NHHD → forces → Ω → motion,
 // each stage the double-precision twin of the fixed-point stage with the same configuration.
 // Where a reference stage takes the firmware's Q16 field types as input (force map, contact),
 // the double values are rounded to Q16 (LSB 2^-16 px), far below every tolerance that uses it.
 class SensorPipelineRef {
  public:
-  SensorPipelineRef(const dsp::PipelineConfig& config, const dsp::Calibration& cal);
+  SensorPipelineRef(const dsp::PipelineConfig& config, const dsp::Calibration& cal,
+                    const ReferenceOptions& options = {});
   void tare();
   // Returns false for a frame the firmware would reject (size/format) — then nothing changes.
-  bool process(const dsp::FrameView& frame, double dt_s, SensorMotionRef& out, bool& degraded);
+  // follow: see MotionRef::update (null: the reference's own stick/slip detector).
+  bool process(const dsp::FrameView& frame, double dt_s, SensorMotionRef& out, bool& degraded,
+               const SlipDecision* follow = nullptr);
 
   const GridVectorD& flow() const { return flow_; }
   const GridVectorD& smoothed() const { return smoothed_; }
@@ -35,6 +50,11 @@ class SensorPipelineRef {
   const std::vector<double>& fz() const { return fz_; }
   const std::vector<double>& shear_x() const { return shear_x_; }
   const std::vector<double>& shear_y() const { return shear_y_; }
+  const ContactSetRef& contact() const { return contact_; }
+  const BlockFlowRef& flow_stage() const { return flow_stage_; }
+  const GridMaskD& flow_valid() const { return flow_valid_; }
+  const GridMaskD& smoothed_valid() const { return smoothed_valid_; }
+  const SensorMotionRef& motion() const { return motion_; }
 
  private:
   dsp::PipelineConfig config_;
@@ -49,6 +69,8 @@ class SensorPipelineRef {
   GridMaskD flow_valid_, smoothed_valid_;
   GridScalarD density_;
   std::vector<double> fz_, shear_x_, shear_y_;
+  ContactSetRef contact_;
+  SensorMotionRef motion_;
 };
 
 struct DualResultRef {
@@ -62,9 +84,12 @@ struct DualResultRef {
 // average as an explicit window mean and the SE(3) integration of dsp/se3 (already double).
 class DualPipelineRef {
  public:
-  DualPipelineRef(const dsp::DualConfig& config, const std::array<dsp::Calibration, 2>& cal);
+  DualPipelineRef(const dsp::DualConfig& config, const std::array<dsp::Calibration, 2>& cal,
+                  const ReferenceOptions& options = {});
+  // follow (may be null): per-sensor stick/slip decisions of the fixed-point pipeline for this
+  // frame pair, to report a "decision-locked" fixed−ref difference next to the free-running one.
   void process(const dsp::FrameView* left, const dsp::FrameView* right, std::int64_t t_ns,
-               DualResultRef& out);
+               DualResultRef& out, const std::array<SlipDecision, 2>* follow = nullptr);
   const SensorPipelineRef& sensor(int i) const { return sensors_[static_cast<std::size_t>(i)]; }
 
  private:
