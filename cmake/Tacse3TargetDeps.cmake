@@ -164,3 +164,43 @@ endfunction()
 macro(tacse3_hal_find_pkg)
   tacse3_find_pkg(${ARGV})
 endmacro()
+
+# toml++ (Debian's libtomlplusplus-dev, header-only, used without exceptions) as the INTERFACE
+# target tacse3_dep_tomlpp, defined once for the calibration reader (hal/config), the daemon's
+# board files (firmware) and the tools. Cross builds take the host's headers through a folder
+# holding only a link to them, so the rest of /usr/include stays out of the target's include path.
+# No toml++: no target, and the callers skip what needs it.
+function(tacse3_find_tomlpp)
+  if(TARGET tacse3_dep_tomlpp)
+    return()
+  endif()
+  find_path(TACSE3_TOMLPP_INCLUDE_DIR toml++/toml.h)
+  set(dir "${TACSE3_TOMLPP_INCLUDE_DIR}")
+  if(NOT dir AND CMAKE_CROSSCOMPILING)
+    find_path(TACSE3_TOMLPP_HOST_INCLUDE_DIR toml++/toml.h PATHS /usr/include
+              NO_CMAKE_FIND_ROOT_PATH NO_DEFAULT_PATH)
+    if(TACSE3_TOMLPP_HOST_INCLUDE_DIR)
+      set(dir "${CMAKE_BINARY_DIR}/_tomlpp/include")
+      file(MAKE_DIRECTORY "${dir}")
+      if(NOT EXISTS "${dir}/toml++")
+        file(CREATE_LINK "${TACSE3_TOMLPP_HOST_INCLUDE_DIR}/toml++" "${dir}/toml++" SYMBOLIC)
+      endif()
+    endif()
+  endif()
+  if(dir)
+    add_library(tacse3_dep_tomlpp INTERFACE IMPORTED GLOBAL)  # imported: a SYSTEM include
+    set_target_properties(tacse3_dep_tomlpp PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${dir}")
+  endif()
+endfunction()
+
+# tacse3_link_if_target(TARGET DEP DEFINE SCOPE): links DEP into TARGET (PUBLIC) and defines
+# DEFINE=1 with SCOPE (PUBLIC or PRIVATE) when DEP is built in this tree, DEFINE=0 otherwise: the
+# optional backends the daemon compiles in or reports as missing.
+function(tacse3_link_if_target target dep define scope)
+  if(TARGET ${dep})
+    target_link_libraries(${target} PUBLIC ${dep})
+    target_compile_definitions(${target} ${scope} ${define}=1)
+  else()
+    target_compile_definitions(${target} ${scope} ${define}=0)
+  endif()
+endfunction()
