@@ -37,12 +37,6 @@ static_assert(drm_fourcc::kNv12 == lc::formats::NV12.fourcc());
 
 constexpr int kMaxSlots = 16;
 
-template <std::size_t N>
-void copy_text(std::array<char, N>& dst, const char* src) noexcept {
-  dst.fill('\0');
-  for (std::size_t n = 0; n + 1 < N && src[n] != '\0'; ++n) dst[n] = src[n];
-}
-
 // libcamera allows one CameraManager per process (a second one is fatal), so every camera of
 // the process shares this one. Only touched at open/reconnect/destruction.
 std::shared_ptr<lc::CameraManager> shared_manager(CameraStatus& status) {

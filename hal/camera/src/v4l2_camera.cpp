@@ -51,21 +51,6 @@ bool is_disconnect_errno(int e) noexcept {
   return e == ENODEV || e == ENXIO;
 }
 
-template <std::size_t N>
-void copy_text(std::array<char, N>& dst, const char* src, std::size_t src_len) noexcept {
-  dst.fill('\0');
-  std::size_t n = 0;
-  while (n + 1 < N && n < src_len && src[n] != '\0') {
-    dst[n] = src[n];
-    ++n;
-  }
-}
-
-template <std::size_t N>
-void copy_text(std::array<char, N>& dst, const char* src) noexcept {
-  copy_text(dst, src, std::strlen(src));
-}
-
 // a/b faster (shorter) than c/d.
 bool shorter(const v4l2_fract& a, const FrameInterval& b) noexcept {
   return !b.known() || static_cast<std::uint64_t>(a.numerator) * b.den <

@@ -43,6 +43,19 @@ inline constexpr std::uint32_t kNv21 = make_fourcc('N', 'V', '2', '1');
 // "YUYV", or "0x12345678" for codes that are not printable.
 std::array<char, 12> fourcc_string(std::uint32_t fourcc) noexcept;
 
+// Copies at most src_len bytes of src (up to its NUL) into a CameraInfo text field, truncated to
+// fit and always NUL-terminated; the rest of the field is zeroed. For driver strings such as
+// v4l2_capability::card, which need not be NUL-terminated.
+template <std::size_t N>
+void copy_text(std::array<char, N>& dst, const char* src, std::size_t src_len) noexcept {
+  dst.fill('\0');
+  for (std::size_t n = 0; n + 1 < N && n < src_len && src[n] != '\0'; ++n) dst[n] = src[n];
+}
+template <std::size_t N>
+void copy_text(std::array<char, N>& dst, const char* src) noexcept {
+  copy_text(dst, src, static_cast<std::size_t>(-1));
+}
+
 const char* to_string(dsp::PixelFormat format) noexcept;
 
 // A frame interval in seconds, num / den (V4L2 struct v4l2_fract). 0/0 = unknown.
