@@ -34,19 +34,8 @@ PACKAGES=(
 mapfile -t VM_PACKAGES < <(tests/vm/setup-host.sh --print)
 PACKAGES+=("${VM_PACKAGES[@]}")
 
-# A Debian mirror mid-sync can serve one index with the wrong size (seen: the armhf security list).
-# Retry with a pause; if one list still fails, continue with what apt has: the install below then
-# fails clearly if a package is truly missing.
-apt_update() {
-  local attempt
-  for attempt in 1 2 3 4; do
-    if $SUDO apt-get update -o Acquire::Retries=5; then return 0; fi
-    echo "setup: apt-get update failed (attempt $attempt); retrying in $((attempt * 15)) s" >&2
-    sleep $((attempt * 15))
-  done
-  echo "setup: apt-get update still reports errors; continuing with the package lists it got" >&2
-}
-apt_update
+. scripts/lib/apt.sh
+apt_update setup
 $SUDO apt-get install "${APT_OPTS[@]}" "${PACKAGES[@]}"
 # Debian's npm conflicts with a NodeSource nodejs: install it only when no npm is present.
 command -v npm >/dev/null || $SUDO apt-get install "${APT_OPTS[@]}" nodejs npm

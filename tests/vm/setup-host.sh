@@ -19,18 +19,8 @@ PACKAGES=(
   apt dpkg coreutils   # apt-get download, dpkg -x, timeout
 )
 if [ "${1:-}" = --print ]; then printf '%s\n' "${PACKAGES[@]}"; exit 0; fi
-# A Debian mirror mid-sync can serve one index with the wrong size: retry with a pause, then go on
-# with the lists apt has (the install below then fails clearly if a package is really missing).
-apt_update() {
-  local attempt
-  for attempt in 1 2 3 4; do
-    if $SUDO apt-get update -o Acquire::Retries=5; then return 0; fi
-    echo "tests/vm/setup-host.sh: apt-get update failed (attempt $attempt); retrying in $((attempt * 15)) s" >&2
-    sleep $((attempt * 15))
-  done
-  echo "tests/vm/setup-host.sh: apt-get update still reports errors; continuing with the lists it got" >&2
-}
-apt_update
+. "$(dirname "$0")/../../scripts/lib/apt.sh"
+apt_update tests/vm/setup-host.sh
 $SUDO apt-get install -y --no-install-recommends -o Acquire::Retries=5 -o DPkg::Lock::Timeout=600 \
   "${PACKAGES[@]}"
 echo "tests/vm/setup-host.sh: done"
