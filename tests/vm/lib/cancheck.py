@@ -250,8 +250,18 @@ def cmd_faults(a):
     t_back = max(t_replug - 1000000, t_unplug)  # the daemon may reopen before the scenario looks
     t_deg = deg["rx_us"] if deg is not None else t_unplug
     during = [c for c in cycles if t_deg < c["rx_us"] < t_back]
-    ok(len(during) >= 10 and all(c["single_sensor"] for c in during),
-       f"{len(during)} cycles while one sensor is gone, all flagged SingleSensor (want >= 10)")
+    # Status reports the pad's health now; frames it captured before it went away may still sit in
+    # its capture ring (8 slots, 67 ms at 119 Hz) and be paired after the LOST report (vivid stamps
+    # frames on its own frame grid, so their times need not precede the report). So: pairs only
+    # within 100 ms of the report, at most a ring's worth; after that every cycle single-sensor.
+    early = [c for c in during if c["rx_us"] <= t_deg + 100000]
+    late = [c for c in during if c["rx_us"] > t_deg + 100000]
+    n_early_pairs = sum(not c["single_sensor"] for c in early)
+    ok(n_early_pairs <= 8,
+       f"{n_early_pairs} pair cycle(s) within 100 ms of the LOST report, from queued frames (want <= 8)")
+    ok(len(late) >= 10 and all(c["single_sensor"] for c in late),
+       f"{len(late)} cycles from 100 ms after the LOST report while one sensor is gone, all flagged "
+       f"SingleSensor (want >= 10)")
     t_all = marker_time(ms, M_UNBIND_ALL)
     ok(is_dual_between(status, t_replug - 1000000, t_all),
        "dual again after the replug (both sensors OK, state not degraded, before the next fault)")
