@@ -165,9 +165,10 @@ def cmd_stream(a):
     nominal = max(v["nominal_fps"] for v in viv.values())
     steady_cycles = [c for c in cycles if c["rx_us"] >= t_nc]
     r = rate_hz(steady_cycles)
-    ok(0.75 * delivered <= r <= 1.02 * nominal,
+    top = a.rate_ceiling * nominal
+    ok(0.75 * delivered <= r <= top,
        f"cycle rate {r:.1f} Hz vs the driver's delivered {delivered:.1f} fps (nominal {nominal:.1f}): "
-       f"want {0.75 * delivered:.1f} .. {1.02 * nominal:.1f}")
+       f"want {0.75 * delivered:.1f} .. {top:.1f}")
     span = (cycles[-1]["rx_us"] - cycles[0]["rx_us"]) * 1e-6
     ok(span >= 0.7 * a.seconds, f"cycles span {span:.2f} s of the {a.seconds} s run")
     ts = [c["t_us"] for c in cycles if c["t_us"] is not None]
@@ -430,6 +431,10 @@ def main():
         if name == "stream":
             p.add_argument("--rate-ref", required=True)
             p.add_argument("--right-health", default="OK")
+            # Upper bound on the cycle rate, in units of the reference's nominal rate: 1.02 for a
+            # driver with a frame clock (vivid's DV timings); more where the reference is itself
+            # a sample of a CPU-bound rate (vimc renders as fast as the TCG guest lets it).
+            p.add_argument("--rate-ceiling", type=float, default=1.02)
             p.add_argument("--seconds", type=float, required=True)
         if name == "commands":
             p.add_argument("--expect", nargs="*", default=[])
