@@ -614,5 +614,76 @@ TEST(BlockFlowReference, KeyframeSequenceAgreesWithDoubleReference) {
   EXPECT_LE(max_err, 0.03);
 }
 
+// The decision-locked reference (dsp_ref::FlowDecision, used only to report the
+// "decision-locked" fixed−ref figure): it reports exactly the given valid set, holds the value of
+// a point it is told was not tracked, and switches keyframes exactly when told.
+TEST(BlockFlowReference, FollowsTheGivenDecisions) {
+  auto f = make_flow();
+  dsp_ref::BlockFlowRef ref;
+  dsp_ref::BlockFlowRef frozen;  // told never to switch
+  f->tare(undeformed());
+  ref.tare(undeformed());
+  frozen.tare(undeformed());
+  VectorField d;
+  GridMask v;
+  std::vector<double> rx, ry, prev_x, prev_y, zx, zy;
+  std::vector<std::uint8_t> rv, zv;
+  constexpr int kFrames = 10;
+  // A block of points the fixed path tracks but the reference is told it did not, from frame 4.
+  const auto dropped = [](int gx, int gy) { return gx >= 18 && gx <= 20 && gy >= 13 && gy <= 15; };
+  int fixed_switches = 0;
+  for (int k = 1; k <= kFrames; ++k) {
+    const WorkImage img =
+        test::render_work_image(texture(), growing_deformation(static_cast<double>(k) / kFrames));
+    f->track(img, d, v);
+    fixed_switches += f->last_frame_was_keyframe() ? 1 : 0;
+    GridMask told = v;
+    for (int gy = 0; gy < kGridHeight; ++gy) {
+      for (int gx = 0; gx < kGridWidth; ++gx) {
+        if (k >= 4 && dropped(gx, gy)) told(gx, gy) = 0;
+      }
+    }
+    const dsp_ref::FlowDecision follow{&told, f->last_frame_was_keyframe()};
+    prev_x = rx;
+    prev_y = ry;
+    ref.track(img, rx, ry, rv, &follow);
+    const dsp_ref::FlowDecision never{&told, false};
+    frozen.track(img, zx, zy, zv, &never);
+    for (int i = 0; i < kGridCount; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      ASSERT_EQ(rv[u], told.v[u]) << "frame " << k << " point " << i;
+      ASSERT_EQ(zv[u], told.v[u]) << "frame " << k << " point " << i;
+    }
+    if (k >= 4) {
+      // Held from frame 3 on: the value of the previous frame, exactly (a keyframe switch does
+      // not move a held point's reported displacement).
+      for (int gy = 13; gy <= 15; ++gy) {
+        for (int gx = 18; gx <= 20; ++gx) {
+          const auto u = static_cast<std::size_t>(gy * kGridWidth + gx);
+          ASSERT_EQ(rx[u], prev_x[u]) << "frame " << k;
+          ASSERT_EQ(ry[u], prev_y[u]) << "frame " << k;
+        }
+      }
+    }
+  }
+  EXPECT_GE(fixed_switches, 3);
+  EXPECT_EQ(ref.keyframe_switches(), fixed_switches);
+  EXPECT_EQ(frozen.keyframe_switches(), 0);
+  // Where both report a point, the values agree as in the free-running comparison above.
+  double sig = 0, err = 0;
+  int compared = 0;
+  for (int i = 0; i < kGridCount; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    if (!rv[u]) continue;
+    const double ex = d.x.v[u] / kQ16 - rx[u], ey = d.y.v[u] / kQ16 - ry[u];
+    sig += rx[u] * rx[u] + ry[u] * ry[u];
+    err += ex * ex + ey * ey;
+    ++compared;
+  }
+  std::printf("  locked: %d points compared, SNR %.1f dB\n", compared, snr_db(sig, err));
+  EXPECT_GT(compared, kGridCount / 2);
+  EXPECT_GE(snr_db(sig, err), 45.0);
+}
+
 }  // namespace
 }  // namespace tacse3::dsp

@@ -17,6 +17,7 @@
 #include "tacse3/dsp_ref/pipeline_ref.hpp"
 #include "tacse3/dsp_ref/smoothing_ref.hpp"
 #include "tacse3/tools/bench.hpp"
+#include "tacse3/tools/locked_reference.hpp"
 #include "tacse3/tools/replay.hpp"
 #include "tacse3/tools/sim_source.hpp"
 
@@ -54,11 +55,23 @@ void diff_vector(const dsp::VectorField& f, const ref::GridVectorD& r, const dsp
   }
 }
 
+// What each decision-locked reference follows: the stick/slip decision only, plus the block
+// flow's validity and keyframe switches, plus the contact mask (all of them).
+const std::array<std::pair<const char*, tt::DecisionFollower::Levels>, 3> kLockLevels = {{
+    {"slip", {true, false, false}},
+    {"slip+flow", {true, true, false}},
+    {"all", {true, true, true}},
+}};
+
 struct Runner {
   tt::ProxyMode mode;
   tt::Replayer engine;
-  std::unique_ptr<ref::DualPipelineRef> ref, locked;
-  std::vector<dsp::Pose> poses, ref_poses, locked_poses;
+  std::unique_ptr<ref::DualPipelineRef> ref;
+  std::vector<dsp::Pose> poses, ref_poses;
+  // Decision-locked references, one per lock level (kLockLevels).
+  std::array<std::unique_ptr<ref::DualPipelineRef>, 3> locked;
+  std::array<tt::DecisionFollower, 3> followers;
+  std::array<std::vector<dsp::Pose>, 3> locked_poses;
   // Accumulated diagnostics.
   long slip_mismatch = 0, frames_contact = 0, mask_mismatch_cells = 0, mask_cells = 0;
   FieldDiff flow, smoothed, d, r, k, shear, shear_in_contact, fz, density;
@@ -136,9 +149,10 @@ int main(int argc, char** argv) {
     }
     r->ref =
         std::make_unique<ref::DualPipelineRef>(r->engine.setup().dual, r->engine.setup().cal, ro);
-    if (r->mode == tt::ProxyMode::kAuto) {
-      r->locked =
+    for (std::size_t l = 0; l < kLockLevels.size(); ++l) {
+      r->locked[l] =
           std::make_unique<ref::DualPipelineRef>(r->engine.setup().dual, r->engine.setup().cal, ro);
+      r->followers[l] = tt::DecisionFollower(kLockLevels[l].second);
     }
     if (!csv_prefix.empty()) {
       const std::string path = csv_prefix + "-" + m + ".csv";
@@ -176,16 +190,12 @@ int main(int argc, char** argv) {
       r.poses.push_back(row.pose);
       r.ref_poses.push_back(ref_out.pose);
       const dsp::DualResult& fres = r.engine.result();
-      if (r.locked) {
-        std::array<ref::SlipDecision, 2> follow{};
-        for (std::size_t s = 0; s < 2; ++s) {
-          follow[s].slipping = fres.sensors[s].motion.slipping;
-          follow[s].stick_confirmed = fres.sensors[s].motion.stick_confirmed;
-        }
+      for (std::size_t l = 0; l < kLockLevels.size(); ++l) {
+        const auto& follow = r.followers[l].take(r.engine.pipeline(), fres);
         ref::DualResultRef lo;
-        r.locked->process(use[0] ? views[0] : nullptr, use[1] ? views[1] : nullptr, info.t_ns[i],
-                          lo, &follow);
-        r.locked_poses.push_back(lo.pose);
+        r.locked[l]->process(use[0] ? views[0] : nullptr, use[1] ? views[1] : nullptr,
+                             info.t_ns[i], lo, &follow);
+        r.locked_poses[l].push_back(lo.pose);
       }
       const Eigen::Vector3d wf = fres.twist.head<3>(), wr = ref_out.twist.head<3>();
       r.omega_diff_int_deg += (wf - wr).norm() * fres.dt_s * 180.0 / M_PI;
@@ -352,12 +362,13 @@ int main(int argc, char** argv) {
         "smoothed %.1f dB, density %.1f, d %.1f, r %.1f, k %.1f\n",
         r.iso_smoothed.snr_db(), r.iso_density.snr_db(), r.iso_d.snr_db(), r.iso_r.snr_db(),
         r.iso_k.snr_db());
-    if (r.locked) {
+    for (std::size_t l = 0; l < kLockLevels.size(); ++l) {
       std::printf(
-          "%-12s  %14.4f  (decision-locked reference: follows the fixed pipeline's "
-          "stick/slip decisions; ref err %.3f)\n",
-          "auto-locked", tt::rotation_error_deg(r.poses.back().q, r.locked_poses.back().q),
-          tt::pose_errors(r.locked_poses, info.truth, info.t_ns).final_rotation_error_deg);
+          "  locked %-10s %10.4f  (reference following the fixed pipeline's %s decisions; "
+          "ref err %.3f)\n",
+          kLockLevels[l].first, tt::rotation_error_deg(r.poses.back().q, r.locked_poses[l].back().q),
+          kLockLevels[l].first,
+          tt::pose_errors(r.locked_poses[l], info.truth, info.t_ns).final_rotation_error_deg);
     }
     if (r.csv != nullptr) std::fclose(r.csv);
   }

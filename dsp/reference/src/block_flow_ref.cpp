@@ -499,12 +499,16 @@ int BlockFlowRef::track_fine(bool retry) {
   fx_.resize(n);
   fy_.resize(n);
   ok_.resize(n);
+  est_x_.resize(n);
+  est_y_.resize(n);
+  est_ok_.resize(n);
   int failed = 0;
   for (int gy = 0; gy < dsp::kGridHeight; ++gy) {
     for (int gx = 0; gx < dsp::kGridWidth; ++gx) {
       const auto i = static_cast<std::size_t>(gy * dsp::kGridWidth + gx);
       if (retry && ok_[i]) continue;
       ok_[i] = 0;
+      est_ok_[i] = 0;
       fx_[i] = tx_[i];
       fy_[i] = ty_[i];
       const WindowRef& m = models_[0][i];
@@ -512,6 +516,11 @@ int BlockFlowRef::track_fine(bool retry) {
       double ux = 0, uy = 0;
       if (retry) coarse_correction(0, gx, gy, ux, uy);
       const Result r = track_window(0, m, tx_[i] + ux, ty_[i] + uy, cfg_.fine_iterations);
+      if (!r.outside) {
+        est_x_[i] = r.ux;
+        est_y_[i] = r.uy;
+        est_ok_[i] = 1;
+      }
       if (!r.valid) {
         failed += r.outside ? 0 : 1;
         continue;
@@ -639,8 +648,30 @@ void BlockFlowRef::re_anchor() {
   valid_ = reported_valid;
 }
 
+// Decision-locked mode: the fixed-point path's valid set replaces this frame's own. A point the
+// fixed path tracked takes the reference's own estimate even where its own tests failed (it
+// holds its previous value only if its window left the image or has no model); a point the
+// fixed path did not track holds its previous value, as it would have there.
+void BlockFlowRef::follow_validity(const dsp::GridMask& valid, const std::vector<double>& held_x,
+                                   const std::vector<double>& held_y) {
+  for (std::size_t i = 0; i < valid_.size(); ++i) {
+    const std::uint8_t want = valid.v[i] != 0 ? 1 : 0;
+    if (want == valid_[i]) continue;
+    valid_[i] = want;
+    if (want != 0) {
+      if (est_ok_[i] == 0) continue;
+      tx_[i] = est_x_[i];
+      ty_[i] = est_y_[i];
+    } else {
+      tx_[i] = held_x[i];
+      ty_[i] = held_y[i];
+    }
+  }
+}
+
 void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
-                         std::vector<double>& dy, std::vector<std::uint8_t>& valid) {
+                         std::vector<double>& dy, std::vector<std::uint8_t>& valid,
+                         const FlowDecision* follow) {
   const auto n = static_cast<std::size_t>(dsp::kGridCount);
   if (!has_reference_) {
     tare(frame);
@@ -650,11 +681,13 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
     return;
   }
   cur_ = build_pyramid_ref(frame, cfg_.pyramid_levels);
+  const std::vector<double> held_x = tx_, held_y = ty_;
   int failed = track_fine(false);
   if (cfg_.pyramid_levels > 1 && failed >= cfg_.coarse_trigger) {
     coarse_levels();
     track_fine(true);
   }
+  if (follow != nullptr && follow->valid != nullptr) follow_validity(*follow->valid, held_x, held_y);
   int count = 0;
   for (const std::uint8_t v : valid_) count += v;
   write_output();
@@ -668,8 +701,12 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
   for (std::size_t i = 0; i < n; ++i) {
     if (valid_[i]) max_sq = std::max(max_sq, tx_[i] * tx_[i] + ty_[i] * ty_[i]);
   }
-  if (max_sq <= cfg_.keyframe_switch_px * cfg_.keyframe_switch_px) return;
-  if (count < cfg_.keyframe_min_valid_fraction * key_valid_count_) return;
+  if (follow != nullptr && follow->valid != nullptr) {
+    if (!follow->keyframe_switch) return;
+  } else {
+    if (max_sq <= cfg_.keyframe_switch_px * cfg_.keyframe_switch_px) return;
+    if (count < cfg_.keyframe_min_valid_fraction * key_valid_count_) return;
+  }
   dkx_ = outx_;
   dky_ = outy_;
   for (int gy = 0; gy < dsp::kGridHeight; ++gy) {

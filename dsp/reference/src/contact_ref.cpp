@@ -25,7 +25,7 @@ void ContactDetectorRef::reset() {
 }
 
 ContactSetRef ContactDetectorRef::detect(const std::vector<double>& fz, const dsp::VectorField& w,
-                                         const dsp::GridMask& valid) {
+                                         const dsp::GridMask& valid, const dsp::GridMask* follow) {
   const auto n = static_cast<std::size_t>(kGridCount);
   ContactSetRef out;
   out.mask.assign(n, 0);
@@ -53,7 +53,10 @@ ContactSetRef ContactDetectorRef::detect(const std::vector<double>& fz, const ds
                    (f > cal_.contact_tau_on || (prev_[i] != 0 && f > cal_.contact_tau_off)))
                       ? 1
                       : 0;
+    if (follow != nullptr) out.mask[i] = follow->v[i] != 0 ? 1 : 0;
   }
+  // A followed mask is already past the minimum-area rule.
+  const int min_area = follow != nullptr ? 0 : cal_.contact_min_area_cells;
   // Connected components (4-neighbourhood), flood fill with an explicit stack.
   std::vector<std::uint8_t> seen(n, 0);
   for (int seed = 0; seed < kGridCount; ++seed) {
@@ -75,7 +78,7 @@ ContactSetRef ContactDetectorRef::detect(const std::vector<double>& fz, const ds
         stack.push_back(static_cast<int>(j));
       }
     }
-    if (static_cast<int>(comp.size()) < cal_.contact_min_area_cells) {
+    if (static_cast<int>(comp.size()) < min_area) {
       for (int c : comp) out.mask[static_cast<std::size_t>(c)] = 0;
     } else {
       ++out.components;

@@ -34,7 +34,7 @@ void SensorPipelineRef::tare() {
 }
 
 bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, SensorMotionRef& out,
-                                bool& degraded, const SlipDecision* follow) {
+                                bool& degraded, const FixedDecisions* follow) {
   out = SensorMotionRef{};
   motion_ = SensorMotionRef{};
   degraded = false;
@@ -46,7 +46,13 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
     tare_pending_ = false;
   }
   std::vector<std::uint8_t> valid;
-  flow_stage_.track(last_work_, flow_.x, flow_.y, valid);
+  FlowDecision flow_follow;
+  if (follow != nullptr && follow->flow_valid != nullptr) {
+    flow_follow.valid = follow->flow_valid;
+    flow_follow.keyframe_switch = follow->keyframe_switch;
+  }
+  flow_stage_.track(last_work_, flow_.x, flow_.y, valid,
+                    flow_follow.valid != nullptr ? &flow_follow : nullptr);
   flow_valid_.assign(valid.begin(), valid.end());
   int tracked = 0;
   for (auto v : valid) tracked += v != 0 ? 1 : 0;
@@ -67,7 +73,8 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
   fz_ = forces.fz;
   shear_x_ = forces.fx;
   shear_y_ = forces.fy;
-  contact_ = contact_stage_.detect(fz_, grid_vector_to_q16(smoothed_), mask_q);
+  contact_ = contact_stage_.detect(fz_, grid_vector_to_q16(smoothed_), mask_q,
+                                   follow != nullptr ? follow->contact : nullptr);
   const ContactSetRef& contact = contact_;
 
   const int min_tracked = static_cast<int>(
@@ -78,7 +85,8 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
     return true;
   }
   const double dt = (std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= 1.0) ? dt_s : 1.0 / 120.0;
-  out = motion_stage_.update(contact, shear_x_, shear_y_, dt, follow);
+  out = motion_stage_.update(contact, shear_x_, shear_y_, dt,
+                             follow != nullptr ? follow->slip : nullptr);
   motion_ = out;
   return true;
 }
@@ -93,7 +101,7 @@ DualPipelineRef::DualPipelineRef(const dsp::DualConfig& config,
 
 void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* right,
                               std::int64_t t_ns, DualResultRef& out,
-                              const std::array<SlipDecision, 2>* follow) {
+                              const std::array<FixedDecisions, 2>* follow) {
   out = DualResultRef{};
   double dt = config_.nominal_frame_period_s;
   if (have_last_t_ && t_ns > last_t_ns_) {
@@ -109,7 +117,8 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
   for (int i = 0; i < 2; ++i) {
     if (frames[i] == nullptr) continue;
     bool degraded = false;
-    const SlipDecision* f = follow != nullptr ? &(*follow)[static_cast<std::size_t>(i)] : nullptr;
+    const FixedDecisions* f =
+        follow != nullptr ? &(*follow)[static_cast<std::size_t>(i)] : nullptr;
     if (sensors_[static_cast<std::size_t>(i)].process(
             *frames[i], dt, m[static_cast<std::size_t>(i)], degraded, f)) {
       ok[static_cast<std::size_t>(i)] = !degraded;

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "tacse3/dsp_ref/pipeline_ref.hpp"
+#include "tacse3/tools/locked_reference.hpp"
 #include "tacse3/tools/sim_source.hpp"
 
 namespace tacse3::tools {
@@ -81,6 +82,7 @@ std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
     std::vector<dsp::Pose> poses;
     std::vector<dsp::Pose> ref_poses, locked_poses;
     std::vector<FrameResult> rows;
+    DecisionFollower follower;
   };
   std::vector<std::unique_ptr<Runner>> runners;
   for (const auto& ec : configs) {
@@ -94,10 +96,8 @@ std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
     if (ec.reference) {
       r->ref =
           std::make_unique<dsp_ref::DualPipelineRef>(r->engine.setup().dual, r->engine.setup().cal);
-      if (ec.mode == ProxyMode::kAuto) {
-        r->locked = std::make_unique<dsp_ref::DualPipelineRef>(r->engine.setup().dual,
-                                                               r->engine.setup().cal);
-      }
+      r->locked =
+          std::make_unique<dsp_ref::DualPipelineRef>(r->engine.setup().dual, r->engine.setup().cal);
     }
     runners.push_back(std::move(r));
   }
@@ -118,11 +118,7 @@ std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
       }
       if (r->locked) {
         const auto& use = r->engine.setup().use;
-        std::array<dsp_ref::SlipDecision, 2> follow{};
-        for (std::size_t s = 0; s < 2; ++s) {
-          follow[s].slipping = r->engine.result().sensors[s].motion.slipping;
-          follow[s].stick_confirmed = r->engine.result().sensors[s].motion.stick_confirmed;
-        }
+        const auto& follow = r->follower.take(r->engine.pipeline(), r->engine.result());
         r->locked->process(use[0] ? views[0] : nullptr, use[1] ? views[1] : nullptr, info.t_ns[i],
                            ref_out, &follow);
         r->locked_poses.push_back(ref_out.pose);

@@ -51,6 +51,17 @@ struct WindowRef {
   Eigen::Matrix2d p_y = Eigen::Matrix2d::Zero();
 };
 
+// The fixed-point path's discrete decisions of one frame, for the "decision-locked" comparison
+// only (docs/dsp.md, "Fixed point vs the double reference"): which points dsp::BlockFlow reported
+// tracked (dsp::SensorFields::flow_valid) and whether it took this frame as its next keyframe.
+// Near a threshold (convergence, residual ratio, neighbour consensus, the keyframe gates) the two
+// arithmetics can decide differently; following these takes those crossings out of the numeric
+// difference. The reference still computes its own estimate at every point.
+struct FlowDecision {
+  const dsp::GridMask* valid = nullptr;  // required
+  bool keyframe_switch = false;
+};
+
 // The block flow of dsp::BlockFlow in double: exact bilinear sampling at the real-valued
 // position, exact inverse, exact divisions, unrounded pyramid. The same config, windows,
 // iteration and validity rules, on-demand coarse-to-fine, output corrections, keyframe policy,
@@ -62,8 +73,9 @@ class BlockFlowRef {
   explicit BlockFlowRef(const dsp::BlockFlowConfig& config = {});
   void tare(const dsp::WorkImage& frame);
   // Displacement relative to the tare frame, working px, row-major 40x30.
+  // follow (may be null): take the validity and keyframe decisions from the fixed-point path.
   void track(const dsp::WorkImage& frame, std::vector<double>& dx, std::vector<double>& dy,
-             std::vector<std::uint8_t>& valid);
+             std::vector<std::uint8_t>& valid, const FlowDecision* follow = nullptr);
   int keyframe_switches() const { return switches_; }
   // Sample on the fixed-point path's grid: positions rounded to 1/32 px, the Gauss-Newton step
   // added to the rounded position, stop when the rounded position repeats. Off (default), the
@@ -92,6 +104,8 @@ class BlockFlowRef {
   int track_fine(bool retry);
   void write_output();
   void re_anchor();
+  void follow_validity(const dsp::GridMask& valid, const std::vector<double>& held_x,
+                       const std::vector<double>& held_y);
   Result track_window(int level, const WindowRef& m, double ux, double uy, int iterations) const;
   bool fit_from_neighbours(int gx, int gy, double& ux, double& uy) const;
 
@@ -102,6 +116,10 @@ class BlockFlowRef {
   std::vector<std::vector<double>> cx_, cy_;  // coarse-level corrections
   std::vector<double> fx_, fy_;               // level-0 estimates of the current frame
   std::vector<std::uint8_t> ok_;
+  // This frame's own level-0 estimate of every window tracked without leaving the image, valid
+  // or not (for follow_validity()).
+  std::vector<double> est_x_, est_y_;
+  std::vector<std::uint8_t> est_ok_;
   std::vector<std::vector<WindowRef>> models_;
   std::vector<double> dkx_, dky_;  // keyframe displacement
   std::vector<double> tx_, ty_;    // window flow since keyframe

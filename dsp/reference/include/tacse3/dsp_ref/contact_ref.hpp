@@ -24,8 +24,11 @@ class ContactDetectorRef {
  public:
   explicit ContactDetectorRef(const dsp::Calibration& cal = {});
   void reset();
+  // follow (may be null): Ω as the fixed-point path reported it (dsp::ContactSet::mask, after
+  // hysteresis and the minimum area) instead of this stage's own thresholds, for the
+  // "decision-locked" comparison only; the filter and the 3D points are still computed here.
   ContactSetRef detect(const std::vector<double>& fz, const dsp::VectorField& w,
-                       const dsp::GridMask& valid);
+                       const dsp::GridMask& valid, const dsp::GridMask* follow = nullptr);
 
  private:
   dsp::Calibration cal_;

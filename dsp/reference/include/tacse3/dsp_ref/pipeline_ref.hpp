@@ -27,6 +27,17 @@ struct ReferenceOptions {
   bool fixed_point_sampling = false;
 };
 
+// The fixed-point pipeline's discrete decisions for one sensor and frame, to report a
+// "decision-locked" fixed−ref difference next to the free-running one (docs/dsp.md). Each part is
+// optional: null pointers leave that decision to the reference. Taken from dsp::SensorFields
+// (flow_valid, contact.mask), dsp::SensorResult (keyframe_switches) and dsp::SensorMotion.
+struct FixedDecisions {
+  const SlipDecision* slip = nullptr;
+  const dsp::GridMask* flow_valid = nullptr;
+  bool keyframe_switch = false;  // with flow_valid
+  const dsp::GridMask* contact = nullptr;
+};
+
 // One sensor's reference chain: luma → block flow → smoothing → 𝒢 → NHHD → forces → Ω → motion,
 // each stage the double-precision twin of the fixed-point stage with the same configuration.
 // Where a reference stage takes the firmware's Q16 field types as input (force map, contact),
@@ -37,9 +48,10 @@ class SensorPipelineRef {
                     const ReferenceOptions& options = {});
   void tare();
   // Returns false for a frame the firmware would reject (size/format) — then nothing changes.
-  // follow: see MotionRef::update (null: the reference's own stick/slip detector).
+  // follow (may be null): the fixed-point pipeline's decisions to take instead of the
+  // reference's own (FixedDecisions).
   bool process(const dsp::FrameView& frame, double dt_s, SensorMotionRef& out, bool& degraded,
-               const SlipDecision* follow = nullptr);
+               const FixedDecisions* follow = nullptr);
 
   const GridVectorD& flow() const { return flow_; }
   const GridVectorD& smoothed() const { return smoothed_; }
@@ -86,10 +98,10 @@ class DualPipelineRef {
  public:
   DualPipelineRef(const dsp::DualConfig& config, const std::array<dsp::Calibration, 2>& cal,
                   const ReferenceOptions& options = {});
-  // follow (may be null): per-sensor stick/slip decisions of the fixed-point pipeline for this
-  // frame pair, to report a "decision-locked" fixed−ref difference next to the free-running one.
+  // follow (may be null): per-sensor decisions of the fixed-point pipeline for this frame pair,
+  // to report a "decision-locked" fixed−ref difference next to the free-running one.
   void process(const dsp::FrameView* left, const dsp::FrameView* right, std::int64_t t_ns,
-               DualResultRef& out, const std::array<SlipDecision, 2>* follow = nullptr);
+               DualResultRef& out, const std::array<FixedDecisions, 2>* follow = nullptr);
   const SensorPipelineRef& sensor(int i) const { return sensors_[static_cast<std::size_t>(i)]; }
 
  private:

@@ -45,8 +45,9 @@ struct EvalResult {
   PoseErrors errors{};
   std::optional<double> reference_error_deg;     // the double reference's final rotation error
   std::optional<double> fixed_vs_reference_deg;  // angle between the two final orientations
-  // kAuto only: the same against a reference that follows the fixed pipeline's per-frame
-  // stick/slip decisions (dsp_ref::SlipDecision), i.e. without the detectors' threshold crossings.
+  // The same against a reference that takes the fixed pipeline's per-frame discrete decisions
+  // (dsp_ref::FixedDecisions: flow validity and keyframe switches, contact mask, stick/slip),
+  // i.e. the arithmetic difference without the threshold crossings (tools::DecisionFollower).
   std::optional<double> fixed_vs_locked_reference_deg;
   std::optional<double> reference_translation_error_mm;
   SlipScore slip{};

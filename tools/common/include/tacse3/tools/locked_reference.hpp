@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tools: the fixed-point pipeline's per-frame decisions, for the decision-locked reference.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "tacse3/dsp/pipeline.hpp"
+#include "tacse3/dsp_ref/pipeline_ref.hpp"
+
+namespace tacse3::tools {
+
+// Collects, after each fixed-point frame, the discrete decisions that dsp_ref::DualPipelineRef
+// can follow (dsp_ref::FixedDecisions): each sensor's flow validity, keyframe switch, contact
+// mask and stick/slip decision. The pointers refer to the pipeline's own fields and stay valid
+// until its next frame. docs/dsp.md, "Fixed point vs the double reference", says what the
+// decision-locked figure measures.
+class DecisionFollower {
+ public:
+  // levels: which decisions to take; by default all of them.
+  struct Levels {
+    bool slip = true;
+    bool flow = true;
+    bool contact = true;
+  };
+  DecisionFollower() = default;
+  explicit DecisionFollower(const Levels& levels) : levels_(levels) {}
+
+  const std::array<dsp_ref::FixedDecisions, 2>& take(const dsp::DualPipeline& pipeline,
+                                                    const dsp::DualResult& result) {
+    for (std::size_t s = 0; s < 2; ++s) {
+      const dsp::SensorResult& r = result.sensors[s];
+      const dsp::SensorFields& f = pipeline.sensor(static_cast<dsp::SensorSlot>(s)).fields();
+      slip_[s].slipping = r.motion.slipping;
+      slip_[s].stick_confirmed = r.motion.stick_confirmed;
+      // The count restarts at a tare; only an increase on a processed frame is a switch.
+      const bool switched = r.processed && r.keyframe_switches > switches_[s];
+      if (r.processed) switches_[s] = r.keyframe_switches;
+      dsp_ref::FixedDecisions& d = out_[s];
+      d.slip = levels_.slip ? &slip_[s] : nullptr;
+      d.flow_valid = levels_.flow ? &f.flow_valid : nullptr;
+      d.keyframe_switch = switched;
+      d.contact = levels_.contact ? &f.contact.mask : nullptr;
+    }
+    return out_;
+  }
+
+ private:
+  Levels levels_{};
+  std::array<dsp_ref::SlipDecision, 2> slip_{};
+  std::array<std::uint32_t, 2> switches_{};
+  std::array<dsp_ref::FixedDecisions, 2> out_{};
+};
+
+}  // namespace tacse3::tools
