@@ -72,6 +72,9 @@ struct Runner {
   std::array<std::unique_ptr<ref::DualPipelineRef>, 3> locked;
   std::array<tt::DecisionFollower, 3> followers;
   std::array<std::vector<dsp::Pose>, 3> locked_poses;
+  // The fully locked chain's own stage differences (what the decisions do not explain).
+  FieldDiff locked_flow, locked_shear;
+  std::array<long, 2> locked_switches{}, fixed_switches{};
   // Accumulated diagnostics.
   long slip_mismatch = 0, frames_contact = 0, mask_mismatch_cells = 0, mask_cells = 0;
   FieldDiff flow, smoothed, d, r, k, shear, shear_in_contact, fz, density;
@@ -196,6 +199,19 @@ int main(int argc, char** argv) {
         r.locked[l]->process(use[0] ? views[0] : nullptr, use[1] ? views[1] : nullptr,
                              info.t_ns[i], lo, &follow);
         r.locked_poses[l].push_back(lo.pose);
+      }
+      for (int s = 0; s < 2; ++s) {
+        if (!use[static_cast<std::size_t>(s)]) continue;
+        const auto& lf = r.engine.pipeline().sensor(static_cast<dsp::SensorSlot>(s)).fields();
+        const auto& ls = r.locked.back()->sensor(s);
+        diff_vector(lf.flow, ls.flow(), lf.flow_valid, nullptr, &r.locked_flow);
+        ref::GridVectorD lsh;
+        lsh.x = ls.shear_x();
+        lsh.y = ls.shear_y();
+        diff_vector(lf.shear, lsh, lf.contact.mask, nullptr, &r.locked_shear);
+        r.locked_switches[static_cast<std::size_t>(s)] = ls.flow_stage().keyframe_switches();
+        r.fixed_switches[static_cast<std::size_t>(s)] =
+            fres.sensors[static_cast<std::size_t>(s)].keyframe_switches;
       }
       const Eigen::Vector3d wf = fres.twist.head<3>(), wr = ref_out.twist.head<3>();
       r.omega_diff_int_deg += (wf - wr).norm() * fres.dt_s * 180.0 / M_PI;
@@ -362,6 +378,11 @@ int main(int argc, char** argv) {
         "smoothed %.1f dB, density %.1f, d %.1f, r %.1f, k %.1f\n",
         r.iso_smoothed.snr_db(), r.iso_density.snr_db(), r.iso_d.snr_db(), r.iso_r.snr_db(),
         r.iso_k.snr_db());
+    std::printf(
+        "  locked all: flow SNR %.1f dB (%ld of %ld components > 0.02 px), shear in Ω SNR "
+        "%.1f dB; keyframe switches fixed %ld/%ld, reference %ld/%ld\n",
+        r.locked_flow.snr_db(), r.locked_flow.big, r.locked_flow.n, r.locked_shear.snr_db(),
+        r.fixed_switches[0], r.fixed_switches[1], r.locked_switches[0], r.locked_switches[1]);
     for (std::size_t l = 0; l < kLockLevels.size(); ++l) {
       std::printf(
           "  locked %-10s %10.4f  (reference following the fixed pipeline's %s decisions; "

@@ -221,7 +221,7 @@ void BlockFlowRef::build_level(int l) {
         m.offset_x = px - (m.ox + kCentre);
         m.offset_y = py - (m.oy + kCentre);
         if (std::abs(m.offset_x) > max_off || std::abs(m.offset_y) > max_off) continue;
-        if (l == 0 && lost_[static_cast<std::size_t>(jy * gw + jx)]) continue;
+        const bool lost = l == 0 && lost_[static_cast<std::size_t>(jy * gw + jx)] != 0;
         double sgx = 0, sgy = 0, sxx = 0, sxy = 0, syy = 0, st = 0, stt = 0;
         double s_xx = 0, s_yy = 0;
         Eigen::Matrix<double, 3, 2> gc = Eigen::Matrix<double, 3, 2>::Zero();
@@ -272,10 +272,13 @@ void BlockFlowRef::build_level(int l) {
             kN * syy - sgy * sgy;
         m.h64 -= m.gain_k * m.gain_k.transpose() / m.gain_e;
         const double a = m.h64(0, 0), b = m.h64(0, 1), c = m.h64(1, 1);
-        if (a <= 0 || c <= 0 || a < tau || c < tau) continue;
-        if ((a - tau) * (c - tau) < b * b) continue;
         const double det = a * c - b * b;
-        if (det <= 0 || det < kappa * (a + c) * (a + c)) continue;
+        if (a <= 0 || c <= 0 || det <= 0) continue;
+        // The texture and conditioning tests decide validity; a window that fails them (or is
+        // lost) still gets its inverse and moments, so that a decision-locked run can track it
+        // where the fixed-point path's tests passed (FlowDecision).
+        const bool textured = a >= tau && c >= tau && (a - tau) * (c - tau) >= b * b &&
+                              det >= kappa * (a + c) * (a + c);
         m.h64_inv = m.h64.inverse();
         {
           const Eigen::Vector2d gbar(sgx / kN, sgy / kN);
@@ -294,7 +297,8 @@ void BlockFlowRef::build_level(int l) {
           m.p_x = m.h64_inv * (kN * mx);
           m.p_y = m.h64_inv * (kN * my);
         }
-        m.valid = true;
+        m.solvable = true;
+        m.valid = textured && !lost;
       }
     }
   }
@@ -512,7 +516,10 @@ int BlockFlowRef::track_fine(bool retry) {
       fx_[i] = tx_[i];
       fy_[i] = ty_[i];
       const WindowRef& m = models_[0][i];
-      if (!m.valid) continue;
+      // Decision-locked: also the windows the fixed-point path tracks where this model failed
+      // its own tests (they stay invalid here; follow_validity() takes the estimate).
+      const bool followed = following_ != nullptr && following_->v[i] != 0 && m.solvable;
+      if (!m.valid && !followed) continue;
       double ux = 0, uy = 0;
       if (retry) coarse_correction(0, gx, gy, ux, uy);
       const Result r = track_window(0, m, tx_[i] + ux, ty_[i] + uy, cfg_.fine_iterations);
@@ -521,8 +528,8 @@ int BlockFlowRef::track_fine(bool retry) {
         est_y_[i] = r.uy;
         est_ok_[i] = 1;
       }
-      if (!r.valid) {
-        failed += r.outside ? 0 : 1;
+      if (!r.valid || !m.valid) {
+        failed += (r.outside || !m.valid) ? 0 : 1;
         continue;
       }
       fx_[i] = r.ux;
@@ -682,11 +689,13 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
   }
   cur_ = build_pyramid_ref(frame, cfg_.pyramid_levels);
   const std::vector<double> held_x = tx_, held_y = ty_;
+  following_ = follow != nullptr ? follow->valid : nullptr;
   int failed = track_fine(false);
   if (cfg_.pyramid_levels > 1 && failed >= cfg_.coarse_trigger) {
     coarse_levels();
     track_fine(true);
   }
+  following_ = nullptr;
   if (follow != nullptr && follow->valid != nullptr) follow_validity(*follow->valid, held_x, held_y);
   int count = 0;
   for (const std::uint8_t v : valid_) count += v;

@@ -33,6 +33,7 @@ struct WindowRef {
   int ox = 0;
   int oy = 0;
   bool valid = false;
+  bool solvable = false;  // inverse and moments computed (valid, or failed only a texture test)
   double offset_x = 0.0;  // material point minus window centre (level px)
   double offset_y = 0.0;
   double gsum_x = 0.0;
@@ -120,6 +121,7 @@ class BlockFlowRef {
   // or not (for follow_validity()).
   std::vector<double> est_x_, est_y_;
   std::vector<std::uint8_t> est_ok_;
+  const dsp::GridMask* following_ = nullptr;  // during track()'s level-0 passes only
   std::vector<std::vector<WindowRef>> models_;
   std::vector<double> dkx_, dky_;  // keyframe displacement
   std::vector<double> tx_, ty_;    // window flow since keyframe
