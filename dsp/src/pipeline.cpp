@@ -109,6 +109,7 @@ void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& 
   flow_.track(fields_.work, fields_.flow, fields_.flow_valid);
   out.tracked_points = flow_.valid_count();
   out.keyframe_switches = flow_.keyframe_switches();
+  out.keyframe_switched = flow_.last_frame_was_keyframe();
 
   // Stage 3: separable Gaussian smoothing, then the Gaussian density 𝒢.
   smoother_.apply(fields_.flow, fields_.flow_valid, fields_.smoothed, fields_.smoothed_valid);

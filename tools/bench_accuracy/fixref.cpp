@@ -209,6 +209,7 @@ int main(int argc, char** argv) {
         lsh.x = ls.shear_x();
         lsh.y = ls.shear_y();
         diff_vector(lf.shear, lsh, lf.contact.mask, nullptr, &r.locked_shear);
+        if (!fres.sensors[static_cast<std::size_t>(s)].processed) continue;
         r.locked_switches[static_cast<std::size_t>(s)] = ls.flow_stage().keyframe_switches();
         r.fixed_switches[static_cast<std::size_t>(s)] =
             fres.sensors[static_cast<std::size_t>(s)].keyframe_switches;

@@ -498,7 +498,7 @@ void BlockFlowRef::coarse_correction(int l, int jx, int jy, double& ox, double& 
 
 // Level 0 (see dsp::BlockFlow::track_fine()): first pass from the warm start, or a retry of
 // the failed windows with the coarse correction; consensus; returns the failure count.
-int BlockFlowRef::track_fine(bool retry) {
+int BlockFlowRef::track_fine(bool retry, const dsp::GridMask* follow_valid) {
   const auto n = static_cast<std::size_t>(dsp::kGridCount);
   fx_.resize(n);
   fy_.resize(n);
@@ -512,13 +512,14 @@ int BlockFlowRef::track_fine(bool retry) {
       const auto i = static_cast<std::size_t>(gy * dsp::kGridWidth + gx);
       if (retry && ok_[i]) continue;
       ok_[i] = 0;
-      est_ok_[i] = 0;
+      if (!retry) est_ok_[i] = 0;  // a retry that leaves the image keeps the first estimate
       fx_[i] = tx_[i];
       fy_[i] = ty_[i];
       const WindowRef& m = models_[0][i];
-      // Decision-locked: also the windows the fixed-point path tracks where this model failed
-      // its own tests (they stay invalid here; follow_validity() takes the estimate).
-      const bool followed = following_ != nullptr && following_->v[i] != 0 && m.solvable;
+      // Decision-locked: a window the fixed-point path tracked has a valid model there, so it is
+      // tracked here like one (retry, consensus test) even where this model failed a texture
+      // test or was lost at the last switch.
+      const bool followed = follow_valid != nullptr && follow_valid->v[i] != 0 && m.solvable;
       if (!m.valid && !followed) continue;
       double ux = 0, uy = 0;
       if (retry) coarse_correction(0, gx, gy, ux, uy);
@@ -528,8 +529,8 @@ int BlockFlowRef::track_fine(bool retry) {
         est_y_[i] = r.uy;
         est_ok_[i] = 1;
       }
-      if (!r.valid || !m.valid) {
-        failed += (r.outside || !m.valid) ? 0 : 1;
+      if (!r.valid) {
+        failed += r.outside ? 0 : 1;
         continue;
       }
       fx_[i] = r.ux;
@@ -688,15 +689,18 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
     return;
   }
   cur_ = build_pyramid_ref(frame, cfg_.pyramid_levels);
-  const std::vector<double> held_x = tx_, held_y = ty_;
-  following_ = follow != nullptr ? follow->valid : nullptr;
-  int failed = track_fine(false);
+  const dsp::GridMask* follow_valid = follow != nullptr ? follow->valid : nullptr;
+  std::vector<double> held_x, held_y;
+  if (follow_valid != nullptr) {
+    held_x = tx_;
+    held_y = ty_;
+  }
+  int failed = track_fine(false, follow_valid);
   if (cfg_.pyramid_levels > 1 && failed >= cfg_.coarse_trigger) {
     coarse_levels();
-    track_fine(true);
+    track_fine(true, follow_valid);
   }
-  following_ = nullptr;
-  if (follow != nullptr && follow->valid != nullptr) follow_validity(*follow->valid, held_x, held_y);
+  if (follow_valid != nullptr) follow_validity(*follow_valid, held_x, held_y);
   int count = 0;
   for (const std::uint8_t v : valid_) count += v;
   write_output();
@@ -706,13 +710,13 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
 
   // Keyframe policy (see dsp::BlockFlow::maybe_switch_keyframe()).
   if (cfg_.keyframe_switch_px <= 0) return;
-  double max_sq = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (valid_[i]) max_sq = std::max(max_sq, tx_[i] * tx_[i] + ty_[i] * ty_[i]);
-  }
-  if (follow != nullptr && follow->valid != nullptr) {
+  if (follow_valid != nullptr) {
     if (!follow->keyframe_switch) return;
   } else {
+    double max_sq = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (valid_[i]) max_sq = std::max(max_sq, tx_[i] * tx_[i] + ty_[i] * ty_[i]);
+    }
     if (max_sq <= cfg_.keyframe_switch_px * cfg_.keyframe_switch_px) return;
     if (count < cfg_.keyframe_min_valid_fraction * key_valid_count_) return;
   }

@@ -53,6 +53,8 @@ ContactSetRef ContactDetectorRef::detect(const std::vector<double>& fz, const ds
                    (f > cal_.contact_tau_on || (prev_[i] != 0 && f > cal_.contact_tau_off)))
                       ? 1
                       : 0;
+    // A followed cell that this chain's flow did not track has filter(f^z) = 0 here, so its
+    // height is 0: harmless when the flow's validity is followed too (then the two agree).
     if (follow != nullptr) out.mask[i] = follow->v[i] != 0 ? 1 : 0;
   }
   // A followed mask is already past the minimum-area rule.

@@ -59,7 +59,7 @@ struct WindowRef {
 // arithmetics can decide differently; following these takes those crossings out of the numeric
 // difference. The reference still computes its own estimate at every point.
 struct FlowDecision {
-  const dsp::GridMask* valid = nullptr;  // required
+  const dsp::GridMask* valid = nullptr;  // null: nothing is followed (keyframe_switch included)
   bool keyframe_switch = false;
 };
 
@@ -102,7 +102,9 @@ class BlockFlowRef {
   void build_level(int level);
   void coarse_levels();
   void coarse_correction(int level, int jx, int jy, double& ox, double& oy) const;
-  int track_fine(bool retry);
+  // follow_valid (decision-locked track() only): also track the windows the fixed-point path
+  // tracked whose model failed only a texture test here.
+  int track_fine(bool retry, const dsp::GridMask* follow_valid = nullptr);
   void write_output();
   void re_anchor();
   void follow_validity(const dsp::GridMask& valid, const std::vector<double>& held_x,
@@ -121,7 +123,6 @@ class BlockFlowRef {
   // or not (for follow_validity()).
   std::vector<double> est_x_, est_y_;
   std::vector<std::uint8_t> est_ok_;
-  const dsp::GridMask* following_ = nullptr;  // during track()'s level-0 passes only
   std::vector<std::vector<WindowRef>> models_;
   std::vector<double> dkx_, dky_;  // keyframe displacement
   std::vector<double> tx_, ty_;    // window flow since keyframe

@@ -30,7 +30,7 @@ struct ReferenceOptions {
 // The fixed-point pipeline's discrete decisions for one sensor and frame, to report a
 // "decision-locked" fixed−ref difference next to the free-running one (docs/dsp.md). Each part is
 // optional: null pointers leave that decision to the reference. Taken from dsp::SensorFields
-// (flow_valid, contact.mask), dsp::SensorResult (keyframe_switches) and dsp::SensorMotion.
+// (flow_valid, contact.mask), dsp::SensorResult (keyframe_switched) and dsp::SensorMotion.
 struct FixedDecisions {
   const SlipDecision* slip = nullptr;
   const dsp::GridMask* flow_valid = nullptr;

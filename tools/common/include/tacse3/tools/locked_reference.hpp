@@ -3,7 +3,6 @@
 #pragma once
 
 #include <array>
-#include <cstdint>
 
 #include "tacse3/dsp/pipeline.hpp"
 #include "tacse3/dsp_ref/pipeline_ref.hpp"
@@ -13,7 +12,8 @@ namespace tacse3::tools {
 // Collects, after each fixed-point frame, the discrete decisions that dsp_ref::DualPipelineRef
 // can follow (dsp_ref::FixedDecisions): each sensor's flow validity, keyframe switch, contact
 // mask and stick/slip decision. The pointers refer to the pipeline's own fields and stay valid
-// until its next frame. docs/dsp.md, "Fixed point vs the double reference", says what the
+// until its next frame. A sensor without a frame this time is not processed by the reference
+// either (DualPipelineRef::process gets no view for it), so its stale fields are never read. docs/dsp.md, "Fixed point vs the double reference", says what the
 // decision-locked figure measures.
 class DecisionFollower {
  public:
@@ -33,13 +33,10 @@ class DecisionFollower {
       const dsp::SensorFields& f = pipeline.sensor(static_cast<dsp::SensorSlot>(s)).fields();
       slip_[s].slipping = r.motion.slipping;
       slip_[s].stick_confirmed = r.motion.stick_confirmed;
-      // The count restarts at a tare; only an increase on a processed frame is a switch.
-      const bool switched = r.processed && r.keyframe_switches > switches_[s];
-      if (r.processed) switches_[s] = r.keyframe_switches;
       dsp_ref::FixedDecisions& d = out_[s];
       d.slip = levels_.slip ? &slip_[s] : nullptr;
       d.flow_valid = levels_.flow ? &f.flow_valid : nullptr;
-      d.keyframe_switch = switched;
+      d.keyframe_switch = r.processed && r.keyframe_switched;
       d.contact = levels_.contact ? &f.contact.mask : nullptr;
     }
     return out_;
@@ -48,7 +45,6 @@ class DecisionFollower {
  private:
   Levels levels_{};
   std::array<dsp_ref::SlipDecision, 2> slip_{};
-  std::array<std::uint32_t, 2> switches_{};
   std::array<dsp_ref::FixedDecisions, 2> out_{};
 };
 
