@@ -46,13 +46,8 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
     tare_pending_ = false;
   }
   std::vector<std::uint8_t> valid;
-  FlowDecision flow_follow;
-  if (follow != nullptr && follow->flow_valid != nullptr) {
-    flow_follow.valid = follow->flow_valid;
-    flow_follow.keyframe_switch = follow->keyframe_switch;
-  }
   flow_stage_.track(last_work_, flow_.x, flow_.y, valid,
-                    flow_follow.valid != nullptr ? &flow_follow : nullptr);
+                    follow != nullptr ? &follow->flow : nullptr);
   flow_valid_.assign(valid.begin(), valid.end());
   int tracked = 0;
   for (auto v : valid) tracked += v != 0 ? 1 : 0;

@@ -33,8 +33,7 @@ struct ReferenceOptions {
 // (flow_valid, contact.mask), dsp::SensorResult (keyframe_switched) and dsp::SensorMotion.
 struct FixedDecisions {
   const SlipDecision* slip = nullptr;
-  const dsp::GridMask* flow_valid = nullptr;
-  bool keyframe_switch = false;  // with flow_valid
+  FlowDecision flow{};  // flow.valid null: the reference's own flow decisions
   const dsp::GridMask* contact = nullptr;
 };
 

@@ -13,8 +13,9 @@ namespace tacse3::tools {
 // can follow (dsp_ref::FixedDecisions): each sensor's flow validity, keyframe switch, contact
 // mask and stick/slip decision. The pointers refer to the pipeline's own fields and stay valid
 // until its next frame. A sensor without a frame this time is not processed by the reference
-// either (DualPipelineRef::process gets no view for it), so its stale fields are never read. docs/dsp.md, "Fixed point vs the double reference", says what the
-// decision-locked figure measures.
+// either (DualPipelineRef::process gets no view for it), so its stale fields are never read.
+// docs/dsp.md, "Fixed point vs the double reference", says what the decision-locked figure
+// measures.
 class DecisionFollower {
  public:
   // levels: which decisions to take; by default all of them.
@@ -35,8 +36,8 @@ class DecisionFollower {
       slip_[s].stick_confirmed = r.motion.stick_confirmed;
       dsp_ref::FixedDecisions& d = out_[s];
       d.slip = levels_.slip ? &slip_[s] : nullptr;
-      d.flow_valid = levels_.flow ? &f.flow_valid : nullptr;
-      d.keyframe_switch = r.processed && r.keyframe_switched;
+      d.flow.valid = levels_.flow ? &f.flow_valid : nullptr;
+      d.flow.keyframe_switch = r.processed && r.keyframe_switched;
       d.contact = levels_.contact ? &f.contact.mask : nullptr;
     }
     return out_;
