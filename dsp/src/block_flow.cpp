@@ -469,6 +469,7 @@ void BlockFlow::tare(const WorkImage& frame) noexcept {
   window_flow_ = VectorField{};
   output_ = VectorField{};
   lost_ = GridMask{};
+  reanchored_ = GridMask{};
   take_keyframe();
   has_reference_ = true;
   keyframe_switches_ = 0;
@@ -1000,6 +1001,7 @@ void BlockFlow::maybe_switch_keyframe() noexcept {
   // re-estimated from the tracked neighbours (local affine fit); points without enough tracked
   // neighbours are lost until the next keyframe or tare.
   key_displacement_ = output_;
+  reanchored_ = GridMask{};
   for (int gy = 0; gy < kGridHeight; ++gy) {
     for (int gx = 0; gx < kGridWidth; ++gx) {
       const auto i = static_cast<std::size_t>(gy * kGridWidth + gx);
@@ -1065,6 +1067,7 @@ void BlockFlow::re_anchor() noexcept {
     key_displacement_.x.v[u] = direct.x.v[u];
     key_displacement_.y.v[u] = direct.y.v[u];
     lost_.v[u] = 0;
+    reanchored_.v[u] = 1;
   }
   output_ = reported;
   frame_valid_ = reported_valid;

@@ -2,6 +2,7 @@
 // tacse3 tests: block flow (Eq. (dense_flow)) against analytic warps and the double reference.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -641,6 +642,7 @@ TEST(BlockFlowReference, FollowsTheGivenDecisions) {
   // A block of points the fixed path tracks but the reference is told it did not, from frame 4.
   const auto dropped = [](int gx, int gy) { return gx >= 18 && gx <= 20 && gy >= 13 && gy <= 15; };
   int fixed_switches = 0;
+  int reanchored_points = 0;
   double strict_worst_rms = 0.0;
   int strict_overruled = 0;
   for (int k = 1; k <= kFrames; ++k) {
@@ -656,8 +658,21 @@ TEST(BlockFlowReference, FollowsTheGivenDecisions) {
     }
     prev_x = rx;
     prev_y = ry;
-    const dsp_ref::FlowDecision follow{&told, f->last_frame_was_keyframe()};
+    const dsp_ref::FlowDecision follow{&told, f->last_frame_was_keyframe(), &f->reanchored(),
+                                       &f->lost()};
     ref.track(img, rx, ry, rv, &follow);
+    if (f->last_frame_was_keyframe()) {
+      // At a switch it re-anchors and loses exactly the fixed path's points. The frozen
+      // reference below never switches, so its re-anchored set stays empty.
+      int re = 0;
+      for (int i = 0; i < kGridCount; ++i) {
+        const auto u = static_cast<std::size_t>(i);
+        ASSERT_EQ(ref.reanchored()[u], f->reanchored().v[u]) << "frame " << k << " point " << i;
+        ASSERT_EQ(ref.lost()[u], f->lost().v[u]) << "frame " << k << " point " << i;
+        re += f->reanchored().v[u];
+      }
+      reanchored_points += re;
+    }
     const dsp_ref::FlowDecision never{&told, false};
     frozen.track(img, zx, zy, zv, &never);
     const dsp_ref::FlowDecision always{&told, true};
@@ -705,6 +720,9 @@ TEST(BlockFlowReference, FollowsTheGivenDecisions) {
   EXPECT_GT(strict_overruled, kGridCount / 8);
   EXPECT_LE(strict_worst_rms, 0.25);
   EXPECT_GE(fixed_switches, 3);
+  std::printf("  re-anchored at the fixed path's switches: %d points\n", reanchored_points);
+  EXPECT_GT(reanchored_points, kGridCount / 2);
+  EXPECT_EQ(std::count(frozen.reanchored().begin(), frozen.reanchored().end(), 1), 0);
   EXPECT_EQ(ref.keyframe_switches(), fixed_switches);
   EXPECT_EQ(frozen.keyframe_switches(), 0);
   EXPECT_EQ(eager.keyframe_switches(), kFrames);

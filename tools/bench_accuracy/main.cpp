@@ -337,7 +337,8 @@ int main(int argc, char** argv) {
       "in the default configuration (dual, joint, auto), with the reference's own error; "
       "`locked`: the same against a reference that takes the fixed pipeline's per-frame "
       "discrete decisions (dsp_ref::FixedDecisions: which flow points are tracked, keyframe "
-      "switches, the contact mask and the stick/slip decision) and computes the rest in double, "
+      "switches with their re-anchored and lost points, the contact mask and the stick/slip "
+      "decision) and computes the rest in double, "
       "i.e. the fixed-point arithmetic's difference apart from a few per-point choices the "
       "reference still makes itself (docs/dsp.md). The free-running figure adds the threshold "
       "crossings where the two arithmetics decide differently.");

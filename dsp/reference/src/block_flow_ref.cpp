@@ -153,6 +153,7 @@ BlockFlowRef::BlockFlowRef(const dsp::BlockFlowConfig& config) : cfg_(config) {
   outy_.assign(n, 0.0);
   valid_.assign(n, 0);
   lost_.assign(n, 0);
+  reanchored_.assign(n, 0);
 }
 
 void BlockFlowRef::tare(const dsp::WorkImage& frame) {
@@ -165,6 +166,7 @@ void BlockFlowRef::tare(const dsp::WorkImage& frame) {
   std::fill(outx_.begin(), outx_.end(), 0.0);
   std::fill(outy_.begin(), outy_.end(), 0.0);
   std::fill(lost_.begin(), lost_.end(), std::uint8_t{0});
+  std::fill(reanchored_.begin(), reanchored_.end(), std::uint8_t{0});
   take_keyframe();
   for (int i = 0; i < dsp::kGridCount; ++i) {
     valid_[static_cast<std::size_t>(i)] = models_[0][static_cast<std::size_t>(i)].valid ? 1 : 0;
@@ -620,7 +622,9 @@ void BlockFlowRef::write_output() {
 }
 
 // Direct match of the current frame against the tare frame (see dsp::BlockFlow::re_anchor()).
-void BlockFlowRef::re_anchor() {
+// follow (may be null): replace exactly the points the fixed path re-anchored.
+void BlockFlowRef::re_anchor(const FlowDecision* follow) {
+  const dsp::GridMask* follow_re = follow != nullptr ? follow->reanchored : nullptr;
   const std::vector<double> reported_x = outx_, reported_y = outy_;
   const std::vector<std::uint8_t> reported_valid = valid_;
   const std::vector<double> chained_x = dkx_, chained_y = dky_;
@@ -633,7 +637,8 @@ void BlockFlowRef::re_anchor() {
   build_level(0);
   tx_ = chained_x;
   ty_ = chained_y;
-  track_fine(false);
+  track_fine(false, follow_re);
+  if (follow_re != nullptr) follow_validity(*follow_re, chained_x, chained_y);
   outx_ = chained_x;
   outy_ = chained_y;
   write_output();
@@ -645,10 +650,11 @@ void BlockFlowRef::re_anchor() {
     if (!valid_[i]) continue;
     const bool agrees =
         std::abs(outx_[i] - chained_x[i]) <= tol && std::abs(outy_[i] - chained_y[i]) <= tol;
-    if (!chained_lost[i] && !agrees) continue;
+    if (follow_re == nullptr && !chained_lost[i] && !agrees) continue;
     dkx_[i] = outx_[i];
     dky_[i] = outy_[i];
     lost_[i] = 0;
+    reanchored_[i] = 1;
   }
   key_ = keyframe;
   outx_ = reported_x;
@@ -722,6 +728,7 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
   }
   dkx_ = outx_;
   dky_ = outy_;
+  std::fill(reanchored_.begin(), reanchored_.end(), std::uint8_t{0});
   for (int gy = 0; gy < dsp::kGridHeight; ++gy) {
     for (int gx = 0; gx < dsp::kGridWidth; ++gx) {
       const auto i = static_cast<std::size_t>(gy * dsp::kGridWidth + gx);
@@ -730,7 +737,11 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
       if (!fit_from_neighbours(gx, gy, dkx_[i], dky_[i])) lost_[i] = 1;
     }
   }
-  if (cfg_.reanchor_tolerance_px > 0) re_anchor();
+  const FlowDecision* follow_switch = follow_valid != nullptr ? follow : nullptr;
+  if (cfg_.reanchor_tolerance_px > 0) re_anchor(follow_switch);
+  if (follow_switch != nullptr && follow_switch->lost != nullptr) {
+    for (std::size_t i = 0; i < n; ++i) lost_[i] = follow_switch->lost->v[i] != 0 ? 1 : 0;
+  }
   key_ = cur_;
   std::fill(tx_.begin(), tx_.end(), 0.0);
   std::fill(ty_.begin(), ty_.end(), 0.0);

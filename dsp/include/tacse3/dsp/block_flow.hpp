@@ -140,6 +140,12 @@ class BlockFlow {
   bool last_frame_was_keyframe() const noexcept { return last_frame_was_keyframe_; }
   int valid_count() const noexcept { return valid_count_; }                    // last track()
   int keyframe_valid_count() const noexcept { return keyframe_valid_count_; }  // level 0
+  // The last keyframe switch's per-point outcome (cleared at a tare): points whose keyframe
+  // displacement was taken from the direct match against the tare frame (re_anchor()), and
+  // points left lost (untracked and not recoverable from neighbours). The decision-locked
+  // double reference follows both (dsp_ref::FlowDecision).
+  const GridMask& reanchored() const noexcept { return reanchored_; }
+  const GridMask& lost() const noexcept { return lost_; }
   // Displacement of each material point at the moment the current keyframe was taken (Q16).
   const VectorField& keyframe_displacement() const noexcept { return key_displacement_; }
   // Translation of each level-0 window since the keyframe (Q16 working px).
@@ -213,6 +219,7 @@ class BlockFlow {
   VectorField output_{};            // last output (held for invalid points)
   GridMask frame_valid_{};
   GridMask lost_{};  // untracked at the last keyframe switch and not recoverable from neighbours
+  GridMask reanchored_{};  // keyframe displacement taken from the direct match at the last switch
   std::array<std::int16_t, kGridCount> window_origin_x_{};  // level-0 window origins
   std::array<std::int16_t, kGridCount> window_origin_y_{};
   // write_output() scratch: window-centre flows, flow gradients {dfx/dx, dfy/dx, dfx/dy,

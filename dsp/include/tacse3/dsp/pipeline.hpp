@@ -89,6 +89,7 @@ class SensorPipeline {
   void restart_motion() noexcept;
 
   const SensorFields& fields() const noexcept { return fields_; }
+  const BlockFlow& flow() const noexcept { return flow_; }
   const PipelineConfig& config() const noexcept { return config_; }
   const Calibration& calibration() const noexcept { return cal_; }
   bool has_reference() const noexcept { return flow_.has_reference(); }

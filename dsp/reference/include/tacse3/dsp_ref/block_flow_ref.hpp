@@ -59,8 +59,15 @@ struct WindowRef {
 // arithmetics can decide differently; following these takes those crossings out of the numeric
 // difference. The reference still computes its own estimate at every point.
 struct FlowDecision {
-  const dsp::GridMask* valid = nullptr;  // null: nothing is followed (keyframe_switch included)
+  const dsp::GridMask* valid = nullptr;  // null: nothing is followed (the rest included)
   bool keyframe_switch = false;
+  // At a switch (each may be null: the reference decides itself): the points whose keyframe
+  // displacement the fixed path took from the direct match against the tare frame
+  // (dsp::BlockFlow::reanchored()), and the points it left lost (dsp::BlockFlow::lost()). A
+  // re-anchored point takes the reference's own direct estimate, even where the reference's
+  // own tolerance or validity test failed.
+  const dsp::GridMask* reanchored = nullptr;
+  const dsp::GridMask* lost = nullptr;
 };
 
 // The block flow of dsp::BlockFlow in double: exact bilinear sampling at the real-valued
@@ -78,6 +85,9 @@ class BlockFlowRef {
   void track(const dsp::WorkImage& frame, std::vector<double>& dx, std::vector<double>& dy,
              std::vector<std::uint8_t>& valid, const FlowDecision* follow = nullptr);
   int keyframe_switches() const { return switches_; }
+  // The last switch's outcome, as dsp::BlockFlow::reanchored() and lost(): 1 per grid point.
+  const std::vector<std::uint8_t>& reanchored() const { return reanchored_; }
+  const std::vector<std::uint8_t>& lost() const { return lost_; }
   // Sample on the fixed-point path's grid: positions rounded to 1/32 px, the Gauss-Newton step
   // added to the rounded position, stop when the rounded position repeats. Off (default), the
   // reference samples at the exact position and stops when |step| < 1/64 px, so it also checks
@@ -106,7 +116,7 @@ class BlockFlowRef {
   // tracked whose model failed only a texture test here.
   int track_fine(bool retry, const dsp::GridMask* follow_valid = nullptr);
   void write_output();
-  void re_anchor();
+  void re_anchor(const FlowDecision* follow);
   void follow_validity(const dsp::GridMask& valid, const std::vector<double>& held_x,
                        const std::vector<double>& held_y);
   Result track_window(int level, const WindowRef& m, double ux, double uy, int iterations) const;
@@ -129,6 +139,7 @@ class BlockFlowRef {
   std::vector<double> outx_, outy_;
   std::vector<std::uint8_t> valid_;
   std::vector<std::uint8_t> lost_;
+  std::vector<std::uint8_t> reanchored_;
   int key_valid_count_ = 0;
   bool fixed_point_sampling_ = false;
 };

@@ -10,8 +10,8 @@
 namespace tacse3::tools {
 
 // Collects, after each fixed-point frame, the discrete decisions that dsp_ref::DualPipelineRef
-// can follow (dsp_ref::FixedDecisions): each sensor's flow validity, keyframe switch, contact
-// mask and stick/slip decision. The pointers refer to the pipeline's own fields and stay valid
+// can follow (dsp_ref::FixedDecisions): each sensor's flow validity, keyframe switch (with its
+// re-anchored and lost points), contact mask and stick/slip decision. The pointers refer to the pipeline's own fields and stay valid
 // until its next frame. A sensor without a frame this time is not processed by the reference
 // either (DualPipelineRef::process gets no view for it), so its stale fields are never read.
 // docs/dsp.md, "Fixed point vs the double reference", says what the decision-locked figure
@@ -31,13 +31,16 @@ class DecisionFollower {
                                                     const dsp::DualResult& result) {
     for (std::size_t s = 0; s < 2; ++s) {
       const dsp::SensorResult& r = result.sensors[s];
-      const dsp::SensorFields& f = pipeline.sensor(static_cast<dsp::SensorSlot>(s)).fields();
+      const dsp::SensorPipeline& sp = pipeline.sensor(static_cast<dsp::SensorSlot>(s));
+      const dsp::SensorFields& f = sp.fields();
       slip_[s].slipping = r.motion.slipping;
       slip_[s].stick_confirmed = r.motion.stick_confirmed;
       dsp_ref::FixedDecisions& d = out_[s];
       d.slip = levels_.slip ? &slip_[s] : nullptr;
       d.flow.valid = levels_.flow ? &f.flow_valid : nullptr;
       d.flow.keyframe_switch = r.processed && r.keyframe_switched;
+      d.flow.reanchored = levels_.flow ? &sp.flow().reanchored() : nullptr;
+      d.flow.lost = levels_.flow ? &sp.flow().lost() : nullptr;
       d.contact = levels_.contact ? &f.contact.mask : nullptr;
     }
     return out_;
