@@ -100,6 +100,13 @@ void report(const char* what, const FlowError& e) {
 
 // --- Accuracy against analytic warps -------------------------------------------------------
 
+// docs/dsp.md quotes this size: the object holds every frame's scratch (no heap, no large stack
+// frames), one per sensor in static storage. The bound is the budget that statement relies on.
+TEST(BlockFlow, StaticFootprint) {
+  std::printf("  sizeof(BlockFlow) = %zu bytes\n", sizeof(BlockFlow));
+  EXPECT_LE(sizeof(BlockFlow), std::size_t{1280} * 1024);
+}
+
 TEST(BlockFlow, SubPixelShifts) {
   auto f = make_flow();
   // Working px (sensor px / 2); the warp is given in sensor px.
