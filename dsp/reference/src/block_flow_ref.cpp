@@ -647,10 +647,12 @@ void BlockFlowRef::re_anchor(const FlowDecision* follow) {
   dky_ = chained_y;
   lost_ = chained_lost;
   for (std::size_t i = 0; i < dkx_.size(); ++i) {
-    if (!valid_[i]) continue;
-    const bool agrees =
-        std::abs(outx_[i] - chained_x[i]) <= tol && std::abs(outy_[i] - chained_y[i]) <= tol;
-    if (follow_re == nullptr && !chained_lost[i] && !agrees) continue;
+    if (!valid_[i]) continue;  // followed: valid_ is exactly the fixed path's re-anchored set
+    if (follow_re == nullptr && !chained_lost[i]) {
+      const bool agrees =
+          std::abs(outx_[i] - chained_x[i]) <= tol && std::abs(outy_[i] - chained_y[i]) <= tol;
+      if (!agrees) continue;
+    }
     dkx_[i] = outx_[i];
     dky_[i] = outy_[i];
     lost_[i] = 0;

@@ -11,11 +11,11 @@ namespace tacse3::tools {
 
 // Collects, after each fixed-point frame, the discrete decisions that dsp_ref::DualPipelineRef
 // can follow (dsp_ref::FixedDecisions): each sensor's flow validity, keyframe switch (with its
-// re-anchored and lost points), contact mask and stick/slip decision. The pointers refer to the pipeline's own fields and stay valid
-// until its next frame. A sensor without a frame this time is not processed by the reference
-// either (DualPipelineRef::process gets no view for it), so its stale fields are never read.
-// docs/dsp.md, "Fixed point vs the double reference", says what the decision-locked figure
-// measures.
+// re-anchored and lost points), contact mask and stick/slip decision. The pointers refer to the
+// pipeline's own fields and stay valid until its next frame. A sensor without a frame this time
+// is not processed by the reference either (DualPipelineRef::process gets no view for it), so
+// its stale fields are never read. docs/dsp.md, "Fixed point vs the double reference", says what
+// the decision-locked figure measures.
 class DecisionFollower {
  public:
   // levels: which decisions to take; by default all of them.
