@@ -89,7 +89,7 @@ BENCHMARK(BM_ContactDetect);
 void BM_MotionUpdate(benchmark::State& state) {
   const Scene& s = scene();
   Calibration cal;
-  // 0 = velocity, 1 = displacement, 2 = auto (stick/slip detector and deficit bookkeeping).
+  // 0 = velocity, 1 = displacement, 2 = auto (stick/slip detector, both readings and solves).
   cal.velocity_proxy = state.range(0) == 2   ? VelocityProxy::kAuto
                        : state.range(0) == 1 ? VelocityProxy::kDisplacement
                                              : VelocityProxy::kVelocity;

@@ -24,12 +24,6 @@ std::int32_t clamp_proxy(std::int64_t v) noexcept {
 // true for any ContactSet a caller may build by hand.
 constexpr std::int64_t kMaxZNm = (std::int64_t{1} << 24) - 1;
 
-// Largest |deficit| per cell (Q16 shear units, 16384 working px): far beyond any real shear, it
-// only keeps the int32 state and the payback products (|A| · h < 2^30 · 2^31 < 2^63) in range.
-constexpr std::int32_t kMaxDeficitQ16 = std::int32_t{1} << 30;
-// Q16 factors of the deficit bookkeeping are clamped to this (a ratio of 32768).
-constexpr std::int64_t kMaxFactorQ16 = std::int64_t{1} << 31;
-
 // Σ ṽ and Σ q_a ṽ_b of one proxy over Ω (the q sums are shared by every proxy).
 struct ProxySums {
   std::int64_t svx = 0, svy = 0, sx_vy = 0, sy_vx = 0, sz_vx = 0, sz_vy = 0;
@@ -59,16 +53,6 @@ struct ProxySums {
     m.sz_vy = sz_vy;
   }
 };
-
-// a · f (f a Q16 factor ≥ 0), rounded to nearest: |a| < 2^31, f ≤ 2^31, no overflow.
-std::int64_t mul_q16(std::int64_t a, std::int64_t f) noexcept {
-  return (a * f + (std::int64_t{1} << 15)) >> 16;
-}
-std::int64_t factor_q16(double f) noexcept {
-  if (!(f > 0.0)) return 0;
-  const double q = std::round(f * 65536.0);
-  return q >= static_cast<double>(kMaxFactorQ16) ? kMaxFactorQ16 : static_cast<std::int64_t>(q);
-}
 
 }  // namespace
 
@@ -145,6 +129,21 @@ void add_normal_equations(const MomentSums& m, Eigen::Matrix3d& AtA,
   Atb += m.sqxv;
 }
 
+SensorMotion velocity_reading(const SensorMotion& m) noexcept {
+  SensorMotion v = m;
+  if (!m.velocity_differs) return v;
+  v.moments = m.velocity_moments;
+  v.proxy_scale = m.velocity_proxy_scale;
+  v.proxy_valid = m.contact;  // the velocity proxy needs no previous frame
+  v.omega = m.velocity_omega;
+  v.solve = m.velocity_solve;
+  v.rotation_valid = v.proxy_valid && m.velocity_solve.valid;
+  v.translation = m.velocity_translation;
+  v.translation_valid = m.velocity_translation_valid;
+  v.velocity_differs = false;
+  return v;
+}
+
 MotionEstimator::MotionEstimator() noexcept {
   (void)configure(Calibration{});
   reset();
@@ -172,9 +171,8 @@ Status MotionEstimator::configure(const Calibration& cal) noexcept {
   exit_fraction_ = cal.slip_exit_fraction;
   rest_speed_ = cal.stick_rest_speed_m_s;
   confirm_s_ = cal.stick_confirm_s;
-  catchup_frames_ = cal.slip_catchup_frames;
   smoothing_s_ = cal.slip_smoothing_s;
-  // Entering or leaving kAuto starts the detector afresh (its deficit belongs to one mode).
+  // Entering or leaving kAuto starts the detector afresh.
   if (was_auto != (mode_ == VelocityProxy::kAuto)) reset_detector();
   return Status::kOk;
 }
@@ -184,10 +182,6 @@ void MotionEstimator::reset_detector() noexcept {
   evidence_frames_ = 0;
   rest_s_ = 0.0;
   peak_shift_m_ = 0.0;
-  catchup_left_ = 0;
-  deficit_x_.fill(0);
-  deficit_y_.fill(0);
-  deficit_t_.setZero();
   content_.setZero();
   have_content_ = false;
 }
@@ -214,24 +208,13 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   const bool automatic = mode_ == VelocityProxy::kAuto;
   const double velocity_scale = c_velocity_ * kQ16Lsb;                 // (m/s) per LSB of shear
   const double displacement_scale = c_displacement_ * kQ16Lsb / dt_s;  // (m/s) per LSB of Δshear
-  // kAuto bookkeeping in the pass (state decided by the previous frames): a sticking contact
-  // accumulates the deficit g·shear − Δshear, g = c_velocity Δt / c_displacement; a slipping one
-  // that is paying back adds h·A/left to its velocity proxy, h = c_displacement/(c_velocity Δt),
-  // and removes A/left from A.
-  const bool accumulate = automatic && !slipping_ && have_prev_shear_;
-  const int left = automatic && slipping_ ? catchup_left_ : 0;
-  const std::int64_t g_q16 = accumulate ? factor_q16(c_velocity_ * dt_s / c_displacement_) : 0;
-  const std::int64_t h_q16 = left > 0 ? factor_q16(c_displacement_ / (c_velocity_ * dt_s)) : 0;
-
   // One pass over Ω: moments (Eq. twist_ls sufficient statistics) of the shear (velocity proxy)
-  // and of its increment (displacement proxy), the payback, and the bookkeeping of the
-  // translation rules (intersection with the previous mask).
+  // and of its increment (displacement proxy), and the bookkeeping of the translation rules
+  // (intersection with the previous mask).
   ContactMoments m;
-  ProxySums sum_shear, sum_increment, sum_payback;
+  ProxySums sum_shear, sum_increment;
   std::int64_t common = 0, common_dx = 0, common_dy = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
-    // A cell outside Ω keeps its deficit: the grid is fixed to the gel material, and a cell at the
-    // patch border that flickers out of Ω for a frame carries the largest lever of a torsion.
     if (contact.mask.v[i] == 0) continue;
     const std::int64_t x = clamp64(contact.x_nm.v[i], -kMaxPointNm, kMaxPointNm);
     const std::int64_t y = clamp64(contact.y_nm.v[i], -kMaxPointNm, kMaxPointNm);
@@ -255,17 +238,6 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     m.szz += z * z;
     sum_shear.add(x, y, z, sx, sy);
     sum_increment.add(x, y, z, dx, dy);
-    if (accumulate) {
-      deficit_x_.v[i] = static_cast<std::int32_t>(
-          clamp64(deficit_x_.v[i] + mul_q16(sx, g_q16) - dx, -kMaxDeficitQ16, kMaxDeficitQ16));
-      deficit_y_.v[i] = static_cast<std::int32_t>(
-          clamp64(deficit_y_.v[i] + mul_q16(sy, g_q16) - dy, -kMaxDeficitQ16, kMaxDeficitQ16));
-    } else if (left > 0) {
-      const std::int64_t px = deficit_x_.v[i] / left, py = deficit_y_.v[i] / left;
-      deficit_x_.v[i] = static_cast<std::int32_t>(deficit_x_.v[i] - px);
-      deficit_y_.v[i] = static_cast<std::int32_t>(deficit_y_.v[i] - py);
-      sum_payback.add(x, y, z, clamp_proxy(mul_q16(px, h_q16)), clamp_proxy(mul_q16(py, h_q16)));
-    }
     if (prev_mask_.v[i] != 0) {
       ++common;
       common_dx += x - clamp64(prev_x_nm_.v[i], -kMaxPointNm, kMaxPointNm);
@@ -276,8 +248,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   out.contact = m.n > 0;
 
   // --- kAuto: the stick/slip detector on the rigid-body content of the shear and its increment.
-  // The proxy of this frame is the one decided up to the previous frame: the deficit bookkeeping
-  // of the pass above already treated this frame as sticking (or paying back).
+  // The proxy of this frame is the one decided up to the previous frame.
   const bool sticking = automatic ? !slipping_ : mode_ == VelocityProxy::kDisplacement;
   if (automatic) {
     if (m.n == 0) {
@@ -310,12 +281,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
           out.slip_onset = true;
           evidence_frames_ = 0;
           peak_shift_m_ = out.shear_shift_m;
-          catchup_left_ = catchup_frames_;
         } else if (rest_s_ >= confirm_s_) {
           out.stick_confirmed = true;
-          deficit_x_.fill(0);
-          deficit_y_.fill(0);
-          deficit_t_.setZero();
         }
       } else {
         peak_shift_m_ = std::max(peak_shift_m_, out.shear_shift_m);
@@ -329,11 +296,11 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     out.slipping = !sticking;
   }
 
-  // Final proxy of this frame.
-  ProxySums final_sums = sticking ? sum_increment : sum_shear;
-  const bool paying = left > 0;
-  if (paying) final_sums.add(sum_payback);
-  final_sums.store(m);
+  // Final proxy of this frame, and (kAuto while sticking) the velocity proxy's reading beside it.
+  out.velocity_differs = automatic && sticking;
+  ContactMoments mv = m;
+  sum_shear.store(mv);
+  (sticking ? sum_increment : sum_shear).store(m);
   out.moments = m;
   out.proxy_valid = !sticking || have_prev_shear_;
   out.proxy_scale = sticking ? displacement_scale : velocity_scale;
@@ -370,36 +337,51 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       disp = common_disp;
       out.translation_source = TranslationSource::kCommonPoints;
       out.translation_valid = true;
-      if (automatic && slide_source != TranslationSource::kNone) {
-        deficit_t_ += slide_disp - common_disp;
-      }
     } else if (slide_source != TranslationSource::kNone) {
       disp = slide_disp;
       out.translation_source = slide_source;
       out.translation_valid = true;
     }
-    if (paying) {
-      const Eigen::Vector2d pay = deficit_t_ / static_cast<double>(left);
-      deficit_t_ -= pay;
-      disp += pay;
-    }
     out.translation =
         translation_scale_.cwiseProduct(Eigen::Vector3d(disp.x(), disp.y(), 0.0) / dt_s);
+    if (out.velocity_differs && slide_source != TranslationSource::kNone) {
+      out.velocity_translation = translation_scale_.cwiseProduct(
+          Eigen::Vector3d(slide_disp.x(), slide_disp.y(), 0.0) / dt_s);
+      out.velocity_translation_valid = true;
+    }
   }
-  if (paying && slipping_) catchup_left_ = left - 1;  // (an exit this frame reset it)
 
   // --- rotation: own-frame shear-only least squares, fixed 3x3 solve.
-  if (m.n > 0) {
-    const MomentSums ms = to_metric(m, out.proxy_scale);
-    out.centroid_m = ms.s1 / ms.n;
+  auto solve_rotation = [&](const ContactMoments& sums, double scale, Solve3Result& result) {
+    const MomentSums ms = to_metric(sums, scale);
     Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
     Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
     add_normal_equations(ms, AtA, Atb);
     Solve3Options opt = solve_options_;
     opt.lambda_abs = ms.n * lever_floor_m_ * lever_floor_m_;
-    out.solve = solve3(AtA, Atb, opt);
-    out.omega = rotation_scale_.cwiseProduct(out.solve.x);
+    result = solve3(AtA, Atb, opt);
+    return Eigen::Vector3d(rotation_scale_.cwiseProduct(result.x));
+  };
+  if (m.n > 0) {
+    out.centroid_m = Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sx),
+                                                     static_cast<double>(m.sy),
+                                                     static_cast<double>(m.sz)) *
+                                     kNm) /
+                     static_cast<double>(m.n);
+    out.omega = solve_rotation(m, out.proxy_scale, out.solve);
     out.rotation_valid = out.proxy_valid && out.solve.valid;
+  }
+  if (out.velocity_differs) {
+    out.velocity_moments = mv;
+    out.velocity_proxy_scale = velocity_scale;
+    if (m.n > 0) out.velocity_omega = solve_rotation(mv, velocity_scale, out.velocity_solve);
+  } else {
+    out.velocity_moments = out.moments;
+    out.velocity_proxy_scale = out.proxy_scale;
+    out.velocity_omega = out.omega;
+    out.velocity_solve = out.solve;
+    out.velocity_translation = out.translation;
+    out.velocity_translation_valid = out.translation_valid;
   }
 
   // --- state for the next frame.

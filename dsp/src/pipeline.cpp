@@ -163,6 +163,8 @@ Status DualPipeline::configure(const DualConfig& config,
     if (s != Status::kOk) return s;
   }
   (void)average_.set_length(cal[0].moving_average_length);
+  payback_.configure(cal[0].slip_catchup_frames);
+  payback_.reset();
   config_ = config;
   cal_ = cal;
   integrator_.reset();
@@ -178,6 +180,7 @@ Status DualPipeline::set_calibration(const std::array<Calibration, 2>& cal) noex
   if (cal[0].moving_average_length != average_.length()) {
     (void)average_.set_length(cal[0].moving_average_length);
   }
+  payback_.configure(cal[0].slip_catchup_frames);
   cal_ = cal;
   return Status::kOk;
 }
@@ -224,9 +227,42 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
   out.valid = out.fused.valid;
   out.single_sensor = out.fused.single_sensor;
 
+  // kAuto: the same frame fused from the velocity readings, and the slip payback of their
+  // difference (slip_payback.hpp). In the fixed modes the readings are equal and nothing is paid.
+  SlipPayback::Frame pf;
+  pf.confirmed = true;
+  bool any_stuck = false;
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (motions[i] == nullptr) continue;
+    any_stuck = any_stuck || motions[i]->velocity_differs;
+    if (!motions[i]->contact) continue;
+    pf.contact = true;
+    pf.onset = pf.onset || motions[i]->slip_onset;
+    pf.confirmed = pf.confirmed && motions[i]->stick_confirmed;
+  }
+  pf.confirmed = pf.confirmed && pf.contact;
+  if (any_stuck) {
+    SensorMotion read[2];
+    const SensorMotion* readings[2] = {nullptr, nullptr};
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (motions[i] == nullptr) continue;
+      read[i] = velocity_reading(*motions[i]);
+      readings[i] = &read[i];
+    }
+    (void)fuse(readings[0], readings[1], config_.fusion, config_.finger_separation_m,
+               out.fused_velocity);
+    pf.differs = true;
+  } else {
+    out.fused_velocity = out.fused;
+  }
+  pf.chosen = out.fused.xi;
+  pf.velocity = out.fused_velocity.xi;
+  if (gap) payback_.reset();
+  out.paid = payback_.update(pf, dt);
+
   // Moving average (Sec. IV-D). A frame without a valid estimate contributes a zero twist: with
   // no evidence of motion the object is held still rather than extrapolated.
-  out.twist = average_.push(out.fused.xi);
+  out.twist = average_.push(out.paid);
 
   // SE(3) integration, T ← T·exp(ξ̂_b Δt) with ξ_b = Ad_{T⁻¹} ξ̄_G (se3.hpp).
   (void)integrator_.step_spatial(out.twist, dt);
@@ -236,6 +272,7 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
 void DualPipeline::tare() noexcept {
   for (auto& s : sensors_) s.tare();
   average_.reset();
+  payback_.reset();
 }
 
 void DualPipeline::reset_pose() noexcept {

@@ -9,6 +9,7 @@
 
 #include "tacse3/dsp/calibration.hpp"
 #include "tacse3/dsp/motion.hpp"
+#include "tacse3/dsp/slip_payback.hpp"
 #include "tacse3/dsp_ref/motion_ref.hpp"
 
 namespace tacse3::dsp {
@@ -18,12 +19,12 @@ constexpr double kDt = 1.0 / 120.0;
 constexpr double kPitchM = 0.6e-3;  // flow-grid spacing on the pad (8 sensor px of 0.075 mm)
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-// A disc of grid cells (radius 6 cells) around the grid centre, 0.5 mm deep, as a ContactSet and
-// as the reference's ContactSetRef (same points).
+// A disc of grid cells (radius 6 cells by default) around the grid centre, 0.5 mm deep, as a
+// ContactSet and as the reference's ContactSetRef (same points).
 struct Disc {
   std::unique_ptr<ContactSet> cs = std::make_unique<ContactSet>();
   dsp_ref::ContactSetRef ref;
-  Disc() {
+  explicit Disc(double radius_cells = 6.0) {
     const auto n = static_cast<std::size_t>(kGridCount);
     ref.mask.assign(n, 0);
     ref.fz_filtered.assign(n, 0.0);
@@ -32,7 +33,7 @@ struct Disc {
       for (int gx = 0; gx < kGridWidth; ++gx) {
         const double x = (gx - kGridWidth / 2 + 0.5) * kPitchM;
         const double y = (gy - kGridHeight / 2 + 0.5) * kPitchM;
-        if (std::hypot(x, y) > 6.0 * kPitchM) continue;
+        if (std::hypot(x, y) > radius_cells * kPitchM) continue;
         const auto i = static_cast<std::size_t>(gy * kGridWidth + gx);
         const auto xn = static_cast<std::int32_t>(std::lround(x * 1e9));
         const auto yn = static_cast<std::int32_t>(std::lround(y * 1e9));
@@ -149,15 +150,54 @@ TEST(SlipDetector, PlanarContentOfARigidShearIsItsRotationAndShift) {
   EXPECT_EQ(planar_content(ContactMoments{}, 1.0), Eigen::Vector3d::Zero());
 }
 
-// Runs one auto and one fixed-mode estimator (and the reference's auto) over a shear history.
+// One sensor's twist [ω; t] as chosen, and as the velocity proxy read it.
+Vector6d chosen_twist(const SensorMotion& m) {
+  Vector6d xi;
+  xi << m.omega, m.translation;
+  return xi;
+}
+Vector6d velocity_twist(const SensorMotion& m) {
+  Vector6d xi;
+  xi << m.velocity_omega, m.velocity_translation;
+  return xi;
+}
+Vector6d chosen_twist(const dsp_ref::SensorMotionRef& m) {
+  Vector6d xi;
+  xi << m.omega, m.translation;
+  return xi;
+}
+Vector6d velocity_twist(const dsp_ref::SensorMotionRef& m) {
+  Vector6d xi;
+  xi << m.velocity_omega, m.velocity_translation;
+  return xi;
+}
+// One frame of the fixed payback for a single sensor, as dsp::DualPipeline feeds it.
+Vector6d pay(SlipPayback& p, const SensorMotion& m) {
+  SlipPayback::Frame f;
+  f.chosen = chosen_twist(m);
+  f.velocity = velocity_twist(m);
+  f.differs = m.velocity_differs;
+  f.contact = m.contact;
+  f.onset = m.slip_onset;
+  f.confirmed = m.contact && m.stick_confirmed;
+  return p.update(f, kDt);
+}
+Vector6d pay(dsp_ref::SlipPaybackRef& p, const dsp_ref::SensorMotionRef& m) {
+  return p.update(chosen_twist(m), velocity_twist(m), m.velocity_differs, m.contact, m.slip_onset,
+                  m.contact && m.stick_confirmed, false, kDt);
+}
+
+// Runs one auto and one fixed-mode estimator (and the reference's auto) over a shear history;
+// the auto ones through the slip payback. disc_at(k) (may be null) gives frame k's contact.
 struct Trace {
   std::vector<Eigen::Vector3d> omega_auto, omega_fixed, omega_ref;
   std::vector<bool> slipping, slipping_ref;
   int onsets = 0;
 };
 
-Trace run(const std::vector<double>& theta, VelocityProxy fixed_mode) {
-  const Disc disc;
+Trace run(const std::vector<double>& theta, VelocityProxy fixed_mode,
+          const Disc* (*disc_at)(std::size_t) = nullptr) {
+  const Disc default_disc;
   const Calibration cal_auto = auto_cal();
   Calibration cal_fixed = base_cal();
   cal_fixed.velocity_proxy = fixed_mode;
@@ -166,18 +206,23 @@ Trace run(const std::vector<double>& theta, VelocityProxy fixed_mode) {
   EXPECT_EQ(a->configure(cal_auto), Status::kOk);
   EXPECT_EQ(f->configure(cal_fixed), Status::kOk);
   dsp_ref::MotionRef ref(cal_auto);
+  SlipPayback payback;
+  payback.configure(cal_auto.slip_catchup_frames);
+  dsp_ref::SlipPaybackRef payback_ref(cal_auto.slip_catchup_frames);
   Trace t;
   auto sh = std::make_unique<VectorField>();
   std::vector<double> sx, sy;
-  for (const double th : theta) {
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    const Disc& disc = disc_at != nullptr ? *disc_at(k) : default_disc;
+    const double th = theta[k];
     disc.shear(th, 0.0, cal_auto.c_displacement, *sh, sx, sy);
     SensorMotion ma, mf;
     EXPECT_EQ(a->update(*disc.cs, *sh, kDt, ma), Status::kOk);
     EXPECT_EQ(f->update(*disc.cs, *sh, kDt, mf), Status::kOk);
     const dsp_ref::SensorMotionRef mr = ref.update(disc.ref, sx, sy, kDt);
-    t.omega_auto.push_back(ma.omega);
+    t.omega_auto.push_back(pay(payback, ma).head<3>());
     t.omega_fixed.push_back(mf.omega);
-    t.omega_ref.push_back(mr.omega);
+    t.omega_ref.push_back(pay(payback_ref, mr).head<3>());
     t.slipping.push_back(ma.slipping);
     t.slipping_ref.push_back(mr.slipping);
     t.onsets += ma.slip_onset ? 1 : 0;
@@ -257,6 +302,33 @@ TEST(SlipDetector, SlideIsDetectedWhenTheShearRelaxesAndThePoseCatchesUp) {
   }
 }
 
+// The deficit is kept in the fused twist, not per grid cell: when Ω shrinks while a slide is
+// still read as a stick (on the simulator's fast slides the mask collapses towards the patch
+// centre), the payback still equals what the velocity proxy read, frame by frame.
+TEST(SlipDetector, PaybackMatchesTheVelocityProxyWhenTheContactShrinksMidSlide) {
+  std::vector<double> theta;
+  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
+  for (int k = 0; k <= 120; ++k) theta.push_back(kDragS * 30.0 * kDeg * min_jerk_rate(k / 120.0));
+  for (int k = 0; k < 60; ++k) theta.push_back(0.0);
+  const Trace t = run(theta, VelocityProxy::kVelocity, [](std::size_t k) -> const Disc* {
+    static const Disc wide(6.0), narrow(3.0);
+    return k >= 24 + 10 && k < 24 + 50 ? &narrow : &wide;
+  });
+  EXPECT_EQ(t.onsets, 1);
+  std::size_t first = theta.size();
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    if (t.slipping[k]) {
+      first = k;
+      break;
+    }
+  }
+  EXPECT_GT(first, 24u + 50u);  // the whole narrow phase was read as a stick
+  const double v_total = integrate_z(t.omega_fixed);
+  EXPECT_NEAR(v_total, 30.0 * kDeg, 0.3 * kDeg);
+  EXPECT_NEAR(integrate_z(t.omega_auto), v_total, 0.01 * v_total);
+  EXPECT_NEAR(integrate_z(t.omega_ref), v_total, 0.01 * v_total);
+}
+
 TEST(SlipDetector, ContactLossRestartsSticking) {
   const Disc disc;
   auto me = std::make_unique<MotionEstimator>();
@@ -296,12 +368,13 @@ TEST(SlipDetector, DecisionLockedReferenceFollowsTheGivenDecisions) {
   auto sh = std::make_unique<VectorField>();
   std::vector<double> sx, sy;
   std::vector<dsp_ref::SlipDecision> fixed_decisions;
+  dsp_ref::SlipPaybackRef pay_free(cal.slip_catchup_frames), pay_locked(cal.slip_catchup_frames);
   int onset_frame = -1;
   for (std::size_t k = 0; k < theta.size(); ++k) {
     disc.shear(theta[k], 0.0, cal.c_displacement, *sh, sx, sy);
     SensorMotion ma;
     ASSERT_EQ(a->update(*disc.cs, *sh, kDt, ma), Status::kOk);
-    const dsp_ref::SlipDecision d{ma.slipping, ma.stick_confirmed};
+    const dsp_ref::SlipDecision d{ma.slipping, ma.stick_confirmed, ma.slip_onset};
     fixed_decisions.push_back(d);
     if (ma.slip_onset && onset_frame < 0) onset_frame = static_cast<int>(k);
     const dsp_ref::SensorMotionRef mf = free_ref.update(disc.ref, sx, sy, kDt);
@@ -309,22 +382,28 @@ TEST(SlipDetector, DecisionLockedReferenceFollowsTheGivenDecisions) {
     // The free reference takes the same decisions here, so locking changes nothing.
     ASSERT_EQ(ml.slipping, ma.slipping) << "frame " << k;
     ASSERT_EQ(mf.slipping, ma.slipping) << "frame " << k;
-    ASSERT_NEAR(ml.omega.z(), mf.omega.z(), 1e-12 + 1e-12 * std::abs(mf.omega.z()))
-        << "frame " << k;
+    ASSERT_EQ(ml.slip_onset, ma.slip_onset) << "frame " << k;
+    ASSERT_EQ(mf.slip_onset, ma.slip_onset) << "frame " << k;
+    const double wf = pay(pay_free, mf).z(), wl = pay(pay_locked, ml).z();
+    ASSERT_NEAR(wl, wf, 1e-12 + 1e-12 * std::abs(wf)) << "frame " << k;
   }
   ASSERT_GT(onset_frame, 0);
-  // Impose an onset 5 frames late: the locked reference follows it (and pays back the deficit
+  // Impose an onset 5 frames late: the locked reference follows it (and the payback starts
   // from then on), so its integrated rotation still reaches the velocity proxy's.
   std::vector<dsp_ref::SlipDecision> late = fixed_decisions;
+  late[static_cast<std::size_t>(onset_frame)].slip_onset = false;
   for (int k = onset_frame + 1; k <= onset_frame + 5; ++k) {
     late[static_cast<std::size_t>(k)].slipping = false;
   }
+  late[static_cast<std::size_t>(onset_frame + 5)].slip_onset = true;
+  dsp_ref::SlipPaybackRef pay_delayed(cal.slip_catchup_frames);
   double total = 0.0;
   for (std::size_t k = 0; k < theta.size(); ++k) {
     disc.shear(theta[k], 0.0, cal.c_displacement, *sh, sx, sy);
     const dsp_ref::SensorMotionRef m = delayed.update(disc.ref, sx, sy, kDt, &late[k]);
     ASSERT_EQ(m.slipping, late[k].slipping) << "frame " << k;
-    total += m.omega.z() * kDt;
+    ASSERT_EQ(m.slip_onset, late[k].slip_onset) << "frame " << k;
+    total += pay(pay_delayed, m).z() * kDt;
   }
   EXPECT_NEAR(total, 30.0 * kDeg, 0.5 * kDeg);
 }

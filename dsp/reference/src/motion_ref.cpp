@@ -73,15 +73,10 @@ MotionRef::MotionRef(const dsp::Calibration& cal) : cal_(cal) {
 }
 
 void MotionRef::reset_detector() {
-  const auto n = static_cast<std::size_t>(dsp::kGridCount);
   slipping_ = false;
   evidence_frames_ = 0;
   rest_s_ = 0.0;
   peak_shift_m_ = 0.0;
-  catchup_left_ = 0;
-  deficit_x_.assign(n, 0.0);
-  deficit_y_.assign(n, 0.0);
-  deficit_t_.setZero();
   content_.setZero();
   have_content_ = false;
 }
@@ -104,27 +99,20 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   if (!automatic) follow = nullptr;
   SensorMotionRef out;
   if (follow != nullptr && follow->slipping != slipping_) {
-    // The followed detector switched at the end of the previous frame: onset (start paying back
-    // over slip_catchup_frames) or exit (the detector restarts, as dsp::MotionEstimator does).
+    // The followed detector switched at the end of the previous frame: onset or exit (the
+    // detector restarts, as dsp::MotionEstimator does).
     if (follow->slipping) {
       slipping_ = true;
       evidence_frames_ = 0;
-      catchup_left_ = cal_.slip_catchup_frames;
     } else {
       reset_detector();
     }
   }
-  // kAuto bookkeeping with the state of the previous frames (dsp::MotionEstimator's rules).
-  const bool accumulate = automatic && !slipping_ && have_prev_shear_;
-  const int left = automatic && slipping_ ? catchup_left_ : 0;
-  const double g = cal_.c_velocity * dt / cal_.c_displacement;
-  const double h = cal_.c_displacement / (cal_.c_velocity * dt);
   int prev_count = 0, common = 0;
   Eigen::Vector3d sum_now = Eigen::Vector3d::Zero(), sum_prev = Eigen::Vector3d::Zero();
   Eigen::Vector3d sum_common = Eigen::Vector3d::Zero();
-  // Per point: shear (velocity reading), increment (displacement reading), payback.
+  // Per point: shear (velocity reading), increment (displacement reading).
   std::vector<PointSample> shear_pts, incr_pts;
-  std::vector<Eigen::Vector3d> payback;
   for (std::size_t i = 0; i < n; ++i) {
     if (prev_mask_[i] != 0) {
       ++prev_count;
@@ -141,17 +129,6 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     shear_pts.push_back(s);
     s.v = dv;
     incr_pts.push_back(s);
-    Eigen::Vector3d pay = Eigen::Vector3d::Zero();
-    if (accumulate) {
-      deficit_x_[i] += g * sv.x() - dv.x();
-      deficit_y_[i] += g * sv.y() - dv.y();
-    } else if (left > 0) {
-      const double px = deficit_x_[i] / left, py = deficit_y_[i] / left;
-      deficit_x_[i] -= px;
-      deficit_y_[i] -= py;
-      pay = Eigen::Vector3d(h * px, h * py, 0.0);
-    }
-    payback.push_back(pay);
     sum_now += s.q;
     if (prev_mask_[i] != 0) {
       ++common;
@@ -201,12 +178,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       const bool rest = out.shear_rate_m_s < cal_.stick_rest_speed_m_s;
       if (follow != nullptr) {
         // Transitions come from the followed decisions (next frame's `slipping`).
-        if (!slipping_ && follow->stick_confirmed) {
-          out.stick_confirmed = true;
-          std::fill(deficit_x_.begin(), deficit_x_.end(), 0.0);
-          std::fill(deficit_y_.begin(), deficit_y_.end(), 0.0);
-          deficit_t_.setZero();
-        }
+        out.slip_onset = follow->slip_onset;
+        if (!slipping_ && follow->stick_confirmed) out.stick_confirmed = true;
       } else if (!slipping_) {
         const bool relaxing = out.shear_shift_m > cal_.slip_min_shift_m &&
                               out.slip_relax_rate > cal_.slip_relax_rate_on;
@@ -217,12 +190,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
           out.slip_onset = true;
           evidence_frames_ = 0;
           peak_shift_m_ = out.shear_shift_m;
-          catchup_left_ = cal_.slip_catchup_frames;
         } else if (rest_s_ >= cal_.stick_confirm_s) {
           out.stick_confirmed = true;
-          std::fill(deficit_x_.begin(), deficit_x_.end(), 0.0);
-          std::fill(deficit_y_.begin(), deficit_y_.end(), 0.0);
-          deficit_t_.setZero();
         }
       } else {
         peak_shift_m_ = std::max(peak_shift_m_, out.shear_shift_m);
@@ -231,16 +200,14 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     }
     out.slipping = !sticking;
   }
-  const bool paying = left > 0;
   out.proxy_valid = !sticking || have_prev_shear_;
-  out.samples = sticking ? incr_pts : shear_pts;
-  for (std::size_t k = 0; k < out.samples.size(); ++k) {
-    PointSample& p = out.samples[k];
-    if (sticking) {
-      p.v *= have_prev_shear_ ? cal_.c_displacement / dt : 0.0;
-    } else {
-      p.v = cal_.c_velocity * (p.v + (paying ? payback[k] : Eigen::Vector3d::Zero()));
-    }
+  out.velocity_differs = automatic && sticking;
+  for (auto& p : shear_pts) p.v *= cal_.c_velocity;
+  if (sticking) {
+    out.samples = incr_pts;
+    for (auto& p : out.samples) p.v *= have_prev_shear_ ? cal_.c_displacement / dt : 0.0;
+  } else {
+    out.samples = shear_pts;
   }
 
   const Eigen::Vector3d tscale(cal_.translation_scale[0], cal_.translation_scale[1],
@@ -265,24 +232,31 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       d = common_d;
       out.translation_source = 2;
       out.translation_valid = true;
-      if (automatic && slide_source != 0) deficit_t_ += (slide - common_d).head<2>();
     } else if (slide_source != 0) {
       d = slide;
       out.translation_source = slide_source;
       out.translation_valid = true;
     }
-    if (paying) {
-      const Eigen::Vector2d pay = deficit_t_ / static_cast<double>(left);
-      deficit_t_ -= pay;
-      d.head<2>() += pay;
-    }
     d.z() = 0.0;
     out.translation = tscale.cwiseProduct(d / dt);
+    if (out.velocity_differs && slide_source != 0) {
+      slide.z() = 0.0;
+      out.velocity_translation = tscale.cwiseProduct(slide / dt);
+      out.velocity_translation_valid = true;
+    }
   }
-  if (paying && slipping_) catchup_left_ = left - 1;  // (an exit this frame reset it)
   if (out.points > 0) {
     out.centroid = sum_now / out.points;
     out.omega = wscale.cwiseProduct(solve(out.samples));
+  }
+  if (out.velocity_differs) {
+    out.velocity_samples = shear_pts;
+    if (out.points > 0) out.velocity_omega = wscale.cwiseProduct(solve(shear_pts));
+  } else {
+    out.velocity_samples = out.samples;
+    out.velocity_omega = out.omega;
+    out.velocity_translation = out.translation;
+    out.velocity_translation_valid = out.translation_valid;
   }
   prev_mask_ = c.mask;
   prev_q_ = c.q;
@@ -290,6 +264,28 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   prev_sy_ = shear_y;
   have_prev_shear_ = true;
   return out;
+}
+
+dsp::Vector6d SlipPaybackRef::update(const dsp::Vector6d& chosen, const dsp::Vector6d& velocity,
+                                     bool differs, bool contact, bool onset, bool confirmed,
+                                     bool gap, double dt) {
+  if (!contact || gap) {
+    deficit_.setZero();
+    left_ = 0;
+  }
+  if (!contact) return chosen;
+  if (differs) deficit_ += (velocity - chosen) * dt;
+  if (confirmed) {
+    deficit_.setZero();
+    left_ = 0;
+    return chosen;
+  }
+  if (onset) left_ = std::max(1, catchup_frames_);
+  if (left_ == 0) return chosen;
+  const dsp::Vector6d pay = deficit_ / static_cast<double>(left_);
+  deficit_ -= pay;
+  --left_;
+  return chosen + pay / dt;
 }
 
 SyntheticSensorFrames render_rigid_contact(const dsp::Calibration& cal,

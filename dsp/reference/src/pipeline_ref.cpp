@@ -89,7 +89,7 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
 DualPipelineRef::DualPipelineRef(const dsp::DualConfig& config,
                                  const std::array<dsp::Calibration, 2>& cal,
                                  const ReferenceOptions& options)
-    : config_(config), cal_(cal) {
+    : config_(config), cal_(cal), payback_(cal[0].slip_catchup_frames) {
   sensors_.emplace_back(config.pipeline, cal[0], options);
   sensors_.emplace_back(config.pipeline, cal[1], options);
 }
@@ -99,9 +99,13 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
                               const std::array<FixedDecisions, 2>* follow) {
   out = DualResultRef{};
   double dt = config_.nominal_frame_period_s;
+  bool gap = false;
   if (have_last_t_ && t_ns > last_t_ns_) {
     dt = static_cast<double>(t_ns - last_t_ns_) * 1e-9;
-    if (dt > config_.max_frame_gap_s) dt = config_.nominal_frame_period_s;
+    if (dt > config_.max_frame_gap_s) {
+      gap = true;
+      dt = config_.nominal_frame_period_s;
+    }
   }
   last_t_ns_ = t_ns;
   have_last_t_ = true;
@@ -120,86 +124,117 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
     }
   }
 
+  // One fusion of the per-sensor readings: the chosen ones, or (velocity) the velocity proxy's.
   const dsp::FusionConfig& fc = config_.fusion;
-  Eigen::Vector3d omega = Eigen::Vector3d::Zero();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  if (fc.method == dsp::FusionMethod::kJoint) {
-    // Every contact point and its proxy in G, one stacked shear-only least squares about the
-    // centroid of all points (dsp/fusion.cpp), λ as in solve3.
-    std::vector<PointSample> all;
-    Eigen::Matrix3d scale = Eigen::Matrix3d::Zero();
-    int nw = 0;
-    for (int i = 0; i < 2; ++i) {
-      const auto& s = m[static_cast<std::size_t>(i)];
-      if (!ok[static_cast<std::size_t>(i)] || !s.contact || !s.proxy_valid) continue;
-      const dsp::SensorExtrinsics& e = fc.extrinsics[static_cast<std::size_t>(i)];
-      const Eigen::Vector3d p = e.p_GS(config_.finger_separation_m);
-      for (const PointSample& ps : s.samples) {
-        PointSample g;
-        g.q = e.R_GS * ps.q + p;
-        g.v = e.R_GS * ps.v;
-        g.normal = e.R_GS * ps.normal;
-        all.push_back(g);
-      }
-      const auto& rs = cal_[static_cast<std::size_t>(i)].rotation_scale;
-      scale += e.R_GS * Eigen::Vector3d(rs[0], rs[1], rs[2]).asDiagonal() * e.R_GS.transpose();
-      ++nw;
-    }
-    if (!all.empty()) {
-      const std::vector<PointSample> about = shifted(all, centroid(all));
-      const StackedSystem sys = stack_shear_rows(about);
-      const double n = static_cast<double>(all.size());
-      const double lambda = fc.solve_lambda_rel * sys.A.squaredNorm() / 3.0 +
-                            n * fc.solve_lever_floor_m * fc.solve_lever_floor_m;
-      omega = (scale / nw) * solve_stacked(sys, lambda);
-      out.rotation_valid = true;
-    }
-    Eigen::Vector3d v_mean = Eigen::Vector3d::Zero();
-    Eigen::Vector3d c_mean = Eigen::Vector3d::Zero();
-    int nt = 0;
-    for (int i = 0; i < 2; ++i) {
-      const auto& s = m[static_cast<std::size_t>(i)];
-      if (!ok[static_cast<std::size_t>(i)] || !s.contact || !s.translation_valid) continue;
-      const dsp::SensorExtrinsics& e = fc.extrinsics[static_cast<std::size_t>(i)];
-      v_mean += e.R_GS * s.translation;
-      c_mean += e.R_GS * s.centroid + e.p_GS(config_.finger_separation_m);
-      ++nt;
-    }
-    if (nt > 0) {
-      t = v_mean / nt - omega.cross(c_mean / nt);
-      t.z() = 0.0;
-    }
-  } else {
-    // Paper Sec. V-C: ξ = ½(ξ₁ + S ξ₂), then R_GS of sensor 1.
-    int nw = 0, nt = 0;
-    for (int i = 0; i < 2; ++i) {
-      const auto& s = m[static_cast<std::size_t>(i)];
-      if (!ok[static_cast<std::size_t>(i)] || !s.contact) continue;
-      Eigen::Vector3d sw = Eigen::Vector3d::Ones(), st = Eigen::Vector3d::Ones();
-      if (i == 1) {
-        sw = Eigen::Vector3d(fc.sign[0], fc.sign[1], fc.sign[2]);
-        st = Eigen::Vector3d(fc.sign[3], fc.sign[4], fc.sign[5]);
-      }
-      if (s.proxy_valid) {
-        omega += sw.cwiseProduct(s.omega);
+  auto fuse = [&](bool velocity, bool& rotation_valid) {
+    Eigen::Vector3d omega = Eigen::Vector3d::Zero();
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    rotation_valid = false;
+    auto samples = [&](const SensorMotionRef& s) -> const std::vector<PointSample>& {
+      return velocity ? s.velocity_samples : s.samples;
+    };
+    auto proxy_valid = [&](const SensorMotionRef& s) { return velocity ? true : s.proxy_valid; };
+    auto translation = [&](const SensorMotionRef& s) {
+      return velocity ? s.velocity_translation : s.translation;
+    };
+    auto translation_valid = [&](const SensorMotionRef& s) {
+      return velocity ? s.velocity_translation_valid : s.translation_valid;
+    };
+    if (fc.method == dsp::FusionMethod::kJoint) {
+      // Every contact point and its proxy in G, one stacked shear-only least squares about the
+      // centroid of all points (dsp/fusion.cpp), λ as in solve3.
+      std::vector<PointSample> all;
+      Eigen::Matrix3d scale = Eigen::Matrix3d::Zero();
+      int nw = 0;
+      for (int i = 0; i < 2; ++i) {
+        const auto& s = m[static_cast<std::size_t>(i)];
+        if (!ok[static_cast<std::size_t>(i)] || !s.contact || !proxy_valid(s)) continue;
+        const dsp::SensorExtrinsics& e = fc.extrinsics[static_cast<std::size_t>(i)];
+        const Eigen::Vector3d p = e.p_GS(config_.finger_separation_m);
+        for (const PointSample& ps : samples(s)) {
+          PointSample g;
+          g.q = e.R_GS * ps.q + p;
+          g.v = e.R_GS * ps.v;
+          g.normal = e.R_GS * ps.normal;
+          all.push_back(g);
+        }
+        const auto& rs = cal_[static_cast<std::size_t>(i)].rotation_scale;
+        scale += e.R_GS * Eigen::Vector3d(rs[0], rs[1], rs[2]).asDiagonal() * e.R_GS.transpose();
         ++nw;
       }
-      if (s.translation_valid) {
-        t += st.cwiseProduct(s.translation);
+      if (!all.empty()) {
+        const std::vector<PointSample> about = shifted(all, centroid(all));
+        const StackedSystem sys = stack_shear_rows(about);
+        const double n = static_cast<double>(all.size());
+        const double lambda = fc.solve_lambda_rel * sys.A.squaredNorm() / 3.0 +
+                              n * fc.solve_lever_floor_m * fc.solve_lever_floor_m;
+        omega = (scale / nw) * solve_stacked(sys, lambda);
+        rotation_valid = true;
+      }
+      Eigen::Vector3d v_mean = Eigen::Vector3d::Zero();
+      Eigen::Vector3d c_mean = Eigen::Vector3d::Zero();
+      int nt = 0;
+      for (int i = 0; i < 2; ++i) {
+        const auto& s = m[static_cast<std::size_t>(i)];
+        if (!ok[static_cast<std::size_t>(i)] || !s.contact || !translation_valid(s)) continue;
+        const dsp::SensorExtrinsics& e = fc.extrinsics[static_cast<std::size_t>(i)];
+        v_mean += e.R_GS * translation(s);
+        c_mean += e.R_GS * s.centroid + e.p_GS(config_.finger_separation_m);
         ++nt;
       }
+      if (nt > 0) {
+        t = v_mean / nt - omega.cross(c_mean / nt);
+        t.z() = 0.0;
+      }
+    } else {
+      // Paper Sec. V-C: ξ = ½(ξ₁ + S ξ₂), then R_GS of sensor 1.
+      int nw = 0, nt = 0;
+      for (int i = 0; i < 2; ++i) {
+        const auto& s = m[static_cast<std::size_t>(i)];
+        if (!ok[static_cast<std::size_t>(i)] || !s.contact) continue;
+        Eigen::Vector3d sw = Eigen::Vector3d::Ones(), st = Eigen::Vector3d::Ones();
+        if (i == 1) {
+          sw = Eigen::Vector3d(fc.sign[0], fc.sign[1], fc.sign[2]);
+          st = Eigen::Vector3d(fc.sign[3], fc.sign[4], fc.sign[5]);
+        }
+        if (proxy_valid(s)) {
+          omega += sw.cwiseProduct(velocity ? s.velocity_omega : s.omega);
+          ++nw;
+        }
+        if (translation_valid(s)) {
+          t += st.cwiseProduct(translation(s));
+          ++nt;
+        }
+      }
+      const Eigen::Matrix3d& R1 = fc.extrinsics[0].R_GS;
+      if (nw > 0) omega = R1 * (omega / nw);
+      if (nt > 0) t = R1 * (t / nt);
+      rotation_valid = nw > 0;
     }
-    const Eigen::Matrix3d& R1 = fc.extrinsics[0].R_GS;
-    if (nw > 0) omega = R1 * (omega / nw);
-    if (nt > 0) t = R1 * (t / nt);
-    out.rotation_valid = nw > 0;
+    dsp::Vector6d xi;
+    xi.head<3>() = omega;
+    xi.tail<3>() = t;
+    return xi;
+  };
+  out.fused = fuse(false, out.rotation_valid);
+
+  // kAuto: slip payback of the velocity readings' fused difference (dsp/slip_payback.hpp).
+  bool contact = false, differs = false, onset = false, confirmed = true, ignored = false;
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (!ok[i]) continue;
+    differs = differs || m[i].velocity_differs;
+    if (!m[i].contact) continue;
+    contact = true;
+    onset = onset || m[i].slip_onset;
+    confirmed = confirmed && m[i].stick_confirmed;
   }
-  out.fused.head<3>() = omega;
-  out.fused.tail<3>() = t;
+  const dsp::Vector6d velocity = differs ? fuse(true, ignored) : out.fused;
+  const dsp::Vector6d paid =
+      payback_.update(out.fused, velocity, differs, contact, onset, confirmed, gap, dt);
 
   // Moving average as an explicit mean over the last L frames.
   const auto L = static_cast<std::size_t>(cal_[0].moving_average_length);
-  window_.push_back(out.fused);
+  window_.push_back(paid);
   if (window_.size() > L) window_.erase(window_.begin());
   dsp::Vector6d sum = dsp::Vector6d::Zero();
   for (const auto& x : window_) sum += x;

@@ -94,7 +94,22 @@ struct SensorMotion {
   double slip_relax_rate = 0.0;  // ρ (1/s), relative decay rate of the shear's rigid content
   double shear_shift_m = 0.0;    // |X| (m), rigid content of the shear read as a displacement
   double shear_rate_m_s = 0.0;   // |dX|/Δt (m/s), rigid content of this frame's increment
+  // --- the same frame as kVelocity would have read it: the velocity proxy's moments and ω, and
+  // the sliding translation rule. Differs from the reading above only while kAuto sticks
+  // (velocity_differs); otherwise a copy of it. The dual pipeline fuses both readings and pays
+  // the difference back at a slip onset (SlipPayback).
+  bool velocity_differs = false;
+  ContactMoments velocity_moments;
+  double velocity_proxy_scale = 0.0;
+  Eigen::Vector3d velocity_omega = Eigen::Vector3d::Zero();
+  Solve3Result velocity_solve;
+  Eigen::Vector3d velocity_translation = Eigen::Vector3d::Zero();
+  bool velocity_translation_valid = false;
 };
+
+// `m` as kVelocity would have read the frame: its velocity_* fields in place of the chosen
+// reading (proxy always defined). Used to fuse the velocity reading beside the chosen one.
+SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 
 // Per-sensor motion stage. State: previous mask, positions, centroid sums and shear field
 // (≈ 25 KB), no heap.
@@ -113,12 +128,9 @@ struct SensorMotion {
 //  - Rotation: int64 moments over Ω, then in double the own-frame normal equations and
 //    solve3 with λ = λ_rel tr/3 + N · lever_floor².
 //  - kAuto (per frame): both proxies' moments are summed in the same pass; the stick/slip
-//    detector (Calibration, docs/dsp.md) picks one. While sticking, the per-cell deficit
-//    A += (c_velocity Δt / c_displacement) · shear − Δshear (Q16 shear units) is kept, i.e. what
-//    the velocity proxy would have read on top of the displacement proxy; at a slip onset it is
-//    paid back as an extra proxy A / k over the next k = slip_catchup_frames frames (the pose
-//    catches up smoothly), and dropped when the stick is confirmed. The translation's deficit
-//    (centroid rule − common-points rule) is kept and paid back the same way.
+//    detector (Calibration, docs/dsp.md) picks one. While sticking, the velocity proxy's reading
+//    (its ω and the sliding translation rule) is reported beside the displacement proxy's; the
+//    dual pipeline fuses both and SlipPayback pays back their fused difference at a slip onset.
 class MotionEstimator {
  public:
   MotionEstimator() noexcept;  // configured with Calibration{} defaults
@@ -159,15 +171,10 @@ class MotionEstimator {
   double exit_fraction_ = 0.0;
   double rest_speed_ = 0.0;
   double confirm_s_ = 0.0;
-  int catchup_frames_ = 1;
   bool slipping_ = false;
   int evidence_frames_ = 0;
   double rest_s_ = 0.0;
   double peak_shift_m_ = 0.0;
-  int catchup_left_ = 0;
-  GridArray<std::int32_t> deficit_x_;  // Q16 shear units (displacement-proxy reading)
-  GridArray<std::int32_t> deficit_y_;
-  Eigen::Vector2d deficit_t_ = Eigen::Vector2d::Zero();  // translation deficit (m)
   double smoothing_s_ = 0.0;
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();  // smoothed X
   bool have_content_ = false;

@@ -15,6 +15,7 @@
 #include "tacse3/dsp/moving_average.hpp"
 #include "tacse3/dsp/nhhd.hpp"
 #include "tacse3/dsp/se3.hpp"
+#include "tacse3/dsp/slip_payback.hpp"
 #include "tacse3/dsp/smoothing.hpp"
 #include "tacse3/dsp/types.hpp"
 
@@ -130,7 +131,11 @@ struct DualResult {
   std::int64_t t_ns = 0;
   std::array<SensorResult, 2> sensors{};  // [left, right]
   std::array<bool, 2> present{false, false};
-  FusedMotion fused{};                         // this frame's fused twist (before averaging)
+  FusedMotion fused{};  // this frame's fused twist (before the payback and averaging)
+  // kAuto: fused twist of the velocity readings (= fused unless some sensor stuck), and the twist
+  // that entered the moving average (fused.xi plus this frame's slip payback).
+  FusedMotion fused_velocity{};
+  Vector6d paid = Vector6d::Zero();
   Vector6d twist = Vector6d::Zero();           // moving-averaged twist ξ̄ in G, [ω rad/s; v m/s]
   Pose pose{};                                 // integrated object pose in G since tare/reset
   bool valid = false;                          // fused.valid for this frame
@@ -173,6 +178,7 @@ class DualPipeline {
   std::array<Calibration, 2> cal_{};
   std::array<SensorPipeline, 2> sensors_{};
   MovingAverage<> average_{};
+  SlipPayback payback_{};
   PoseIntegrator integrator_{};
   std::int64_t last_t_ns_ = 0;
   bool have_last_t_ = false;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tacse3/dsp/calibration.hpp"
+#include "tacse3/dsp/se3.hpp"
 #include "tacse3/dsp/types.hpp"
 #include "tacse3/dsp_ref/contact_ref.hpp"
 
@@ -53,15 +54,24 @@ struct SensorMotionRef {
   double slip_relax_rate = 0.0;
   double shear_shift_m = 0.0;
   double shear_rate_m_s = 0.0;
+  // The frame as kVelocity would have read it (dsp::SensorMotion's velocity_* fields).
+  bool velocity_differs = false;
+  std::vector<PointSample> velocity_samples;
+  Eigen::Vector3d velocity_omega = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_translation = Eigen::Vector3d::Zero();
+  bool velocity_translation_valid = false;
 };
 
 // A stick/slip decision to follow (kAuto only), taken from the fixed-point pipeline's
-// dsp::SensorMotion of the same frame: `slipping` is the proxy that frame used, `stick_confirmed`
-// whether it dropped the deficit. Used ONLY to measure the numeric fixed−ref difference with the
-// detector's threshold crossings taken out ("decision-locked"; docs/dsp.md).
+// dsp::SensorMotion of the same frame: `slipping` is the proxy that frame used, `slip_onset`
+// whether the detector switched to slip at its end, `stick_confirmed` whether it confirmed a
+// stick (the dual pipeline's slip payback reads both). Used ONLY to measure the numeric
+// fixed−ref difference with the detector's threshold crossings taken out ("decision-locked";
+// docs/dsp.md).
 struct SlipDecision {
   bool slipping = false;
   bool stick_confirmed = false;
+  bool slip_onset = false;
 };
 
 // Same rules as dsp::MotionEstimator (translation sources, proxy modes, λ), in double.
@@ -87,12 +97,25 @@ class MotionRef {
   int evidence_frames_ = 0;
   double rest_s_ = 0.0;
   double peak_shift_m_ = 0.0;
-  int catchup_left_ = 0;
-  std::vector<double> deficit_x_, deficit_y_;  // shear units
-  Eigen::Vector2d deficit_t_ = Eigen::Vector2d::Zero();
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();
   bool have_content_ = false;
   void reset_detector();
+};
+
+// dsp::SlipPayback in plain form: the deficit D (fused velocity reading − fused chosen reading,
+// integrated while some sensor sticks) is paid back as D/left over slip_catchup_frames frames
+// from a slip onset, and dropped on a confirmed stick, without contact or after a gap.
+class SlipPaybackRef {
+ public:
+  explicit SlipPaybackRef(int catchup_frames) : catchup_frames_(catchup_frames) {}
+  // Returns the twist to use: chosen plus this frame's payback.
+  dsp::Vector6d update(const dsp::Vector6d& chosen, const dsp::Vector6d& velocity, bool differs,
+                       bool contact, bool onset, bool confirmed, bool gap, double dt);
+
+ private:
+  int catchup_frames_;
+  int left_ = 0;
+  dsp::Vector6d deficit_ = dsp::Vector6d::Zero();
 };
 
 // --- Analytic scene for tests and benchmarks: one pad touching an object that moves rigidly.

@@ -85,7 +85,7 @@ class SensorPipelineRef {
 };
 
 struct DualResultRef {
-  dsp::Vector6d fused = dsp::Vector6d::Zero();  // this frame's fused twist
+  dsp::Vector6d fused = dsp::Vector6d::Zero();  // this frame's fused twist (before the payback)
   dsp::Vector6d twist = dsp::Vector6d::Zero();  // moving average
   dsp::Pose pose{};
   bool rotation_valid = false;
@@ -108,6 +108,7 @@ class DualPipelineRef {
   std::array<dsp::Calibration, 2> cal_;
   std::vector<SensorPipelineRef> sensors_;
   std::vector<dsp::Vector6d> window_;
+  SlipPaybackRef payback_;
   dsp::Pose pose_{};
   std::int64_t last_t_ns_ = 0;
   bool have_last_t_ = false;
