@@ -230,6 +230,24 @@ Trace run(const std::vector<double>& theta, VelocityProxy fixed_mode,
   return t;
 }
 
+// First frame the auto estimator used the velocity proxy (size of the trace if none).
+std::size_t first_slipping(const Trace& t) {
+  for (std::size_t k = 0; k < t.slipping.size(); ++k) {
+    if (t.slipping[k]) return k;
+  }
+  return t.slipping.size();
+}
+
+// The slide shear history: rest 24 frames, a 30° minimum-jerk rotation over 1 s read through the
+// gel's drag (shear ∝ sliding speed, lag ignored), rest 60 frames.
+std::vector<double> slide_theta() {
+  std::vector<double> theta;
+  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
+  for (int k = 0; k <= 120; ++k) theta.push_back(kDragS * 30.0 * kDeg * min_jerk_rate(k / 120.0));
+  for (int k = 0; k < 60; ++k) theta.push_back(0.0);
+  return theta;
+}
+
 double integrate_z(const std::vector<Eigen::Vector3d>& w) {
   double s = 0.0;
   for (const auto& v : w) s += v.z() * kDt;
@@ -259,23 +277,11 @@ TEST(SlipDetector, SlideIsDetectedWhenTheShearRelaxesAndThePoseCatchesUp) {
   // minimum-jerk speed profile of a 30° rotation over 1 s, then 0.5 s at rest. The velocity
   // proxy with c_velocity = c_displacement / drag reads it exactly.
   const Calibration cal = auto_cal();
-  const double drag_s = kDragS;
-  std::vector<double> theta;
-  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
-  for (int k = 0; k <= 120; ++k) {
-    theta.push_back(drag_s * 30.0 * kDeg * min_jerk_rate(k / 120.0) / 1.0);
-  }
-  for (int k = 0; k < 60; ++k) theta.push_back(0.0);
+  const std::vector<double> theta = slide_theta();
   const Trace t = run(theta, VelocityProxy::kVelocity);
   EXPECT_EQ(t.onsets, 1);
   // Detected in the second half of the slide (the shear relaxes as the slide slows) ...
-  std::size_t first = theta.size();
-  for (std::size_t k = 0; k < theta.size(); ++k) {
-    if (t.slipping[k]) {
-      first = k;
-      break;
-    }
-  }
+  const std::size_t first = first_slipping(t);
   EXPECT_GT(first, 24u + 60u);
   EXPECT_LT(first, 24u + 120u);
   // ... and back to stick once the shear has relaxed at rest.
@@ -306,22 +312,13 @@ TEST(SlipDetector, SlideIsDetectedWhenTheShearRelaxesAndThePoseCatchesUp) {
 // still read as a stick (on the simulator's fast slides the mask collapses towards the patch
 // centre), the payback still equals what the velocity proxy read, frame by frame.
 TEST(SlipDetector, PaybackMatchesTheVelocityProxyWhenTheContactShrinksMidSlide) {
-  std::vector<double> theta;
-  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
-  for (int k = 0; k <= 120; ++k) theta.push_back(kDragS * 30.0 * kDeg * min_jerk_rate(k / 120.0));
-  for (int k = 0; k < 60; ++k) theta.push_back(0.0);
+  const std::vector<double> theta = slide_theta();
   const Trace t = run(theta, VelocityProxy::kVelocity, [](std::size_t k) -> const Disc* {
     static const Disc wide(6.0), narrow(3.0);
     return k >= 24 + 10 && k < 24 + 50 ? &narrow : &wide;
   });
   EXPECT_EQ(t.onsets, 1);
-  std::size_t first = theta.size();
-  for (std::size_t k = 0; k < theta.size(); ++k) {
-    if (t.slipping[k]) {
-      first = k;
-      break;
-    }
-  }
+  const std::size_t first = first_slipping(t);
   EXPECT_GT(first, 24u + 50u);  // the whole narrow phase was read as a stick
   const double v_total = integrate_z(t.omega_fixed);
   EXPECT_NEAR(v_total, 30.0 * kDeg, 0.3 * kDeg);
@@ -358,10 +355,7 @@ TEST(SlipDetector, ContactLossRestartsSticking) {
 TEST(SlipDetector, DecisionLockedReferenceFollowsTheGivenDecisions) {
   const Disc disc;
   const Calibration cal = auto_cal();
-  std::vector<double> theta;
-  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
-  for (int k = 0; k <= 120; ++k) theta.push_back(kDragS * 30.0 * kDeg * min_jerk_rate(k / 120.0));
-  for (int k = 0; k < 60; ++k) theta.push_back(0.0);
+  const std::vector<double> theta = slide_theta();
   auto a = std::make_unique<MotionEstimator>();
   ASSERT_EQ(a->configure(cal), Status::kOk);
   dsp_ref::MotionRef free_ref(cal), locked(cal), delayed(cal);
