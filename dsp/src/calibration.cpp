@@ -49,6 +49,7 @@ Status validate(const Calibration& c) noexcept {
   for (int a = 0; a < 3; ++a) {
     ok = ok && in_range(c.rotation_scale[static_cast<std::size_t>(a)], 0.0, 100.0);
     ok = ok && in_range(c.translation_scale[static_cast<std::size_t>(a)], 0.0, 100.0);
+    ok = ok && in_range(c.displacement_rotation_ratio[static_cast<std::size_t>(a)], 0.0, 100.0);
   }
   ok = ok && c.moving_average_length >= 1 && c.moving_average_length <= kMaxMovingAverage;
   ok = ok && in_range(c.solve_lambda_rel, 0.0, 1.0);

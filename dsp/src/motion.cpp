@@ -134,6 +134,7 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept {
   if (!m.velocity_differs) return v;
   v.moments = m.velocity_moments;
   v.proxy_scale = m.velocity_proxy_scale;
+  v.rotation_scale = m.velocity_rotation_scale;
   v.proxy_valid = m.contact;  // the velocity proxy needs no previous frame
   v.omega = m.velocity_omega;
   v.solve = m.velocity_solve;
@@ -159,6 +160,9 @@ Status MotionEstimator::configure(const Calibration& cal) noexcept {
   max_mask_change_ = cal.max_mask_change;
   rotation_scale_ =
       Eigen::Vector3d(cal.rotation_scale[0], cal.rotation_scale[1], cal.rotation_scale[2]);
+  displacement_rotation_scale_ = rotation_scale_.cwiseProduct(
+      Eigen::Vector3d(cal.displacement_rotation_ratio[0], cal.displacement_rotation_ratio[1],
+                      cal.displacement_rotation_ratio[2]));
   translation_scale_ =
       Eigen::Vector3d(cal.translation_scale[0], cal.translation_scale[1], cal.translation_scale[2]);
   solve_options_.lambda_rel = cal.solve_lambda_rel;
@@ -211,8 +215,24 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // One pass over Ω: moments (Eq. twist_ls sufficient statistics) of the shear (velocity proxy)
   // and of its increment (displacement proxy), and the bookkeeping of the translation rules
   // (intersection with the previous mask).
-  ContactMoments m;
+  // m: every cell of Ω_t (translation, shear). m_stayed: the cells also in Ω_{t−1}, the only ones
+  // with a shear increment: a cell that (re-)enters Ω was usually not tracked by the flow while
+  // it was out, holds a stale shear, and its first increment would be the whole catch-up at the
+  // patch rim (docs/accuracy.md: an uncalibrated sphere rz 4° stick read as 6.84°).
+  ContactMoments m, m_stayed;
   ProxySums sum_shear, sum_increment;
+  const auto add_point = [](ContactMoments& c, std::int64_t x, std::int64_t y, std::int64_t z) {
+    ++c.n;
+    c.sx += x;
+    c.sy += y;
+    c.sz += z;
+    c.sxx += x * x;
+    c.sxy += x * y;
+    c.sxz += x * z;
+    c.syy += y * y;
+    c.syz += y * z;
+    c.szz += z * z;
+  };
   std::int64_t common = 0, common_dx = 0, common_dy = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
     if (contact.mask.v[i] == 0) continue;
@@ -221,24 +241,17 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     const std::int64_t z = clamp64(contact.z_nm.v[i], 0, kMaxZNm);
     const std::int64_t sx = clamp_proxy(shear.x.v[i]);
     const std::int64_t sy = clamp_proxy(shear.y.v[i]);
-    std::int64_t dx = 0, dy = 0;
-    if (have_prev_shear_) {
-      dx = clamp_proxy(static_cast<std::int64_t>(shear.x.v[i]) - prev_shear_.x.v[i]);
-      dy = clamp_proxy(static_cast<std::int64_t>(shear.y.v[i]) - prev_shear_.y.v[i]);
-    }
-    ++m.n;
-    m.sx += x;
-    m.sy += y;
-    m.sz += z;
-    m.sxx += x * x;
-    m.sxy += x * y;
-    m.sxz += x * z;
-    m.syy += y * y;
-    m.syz += y * z;
-    m.szz += z * z;
+    const bool stayed = prev_mask_.v[i] != 0;
+    add_point(m, x, y, z);
     sum_shear.add(x, y, z, sx, sy);
-    sum_increment.add(x, y, z, dx, dy);
-    if (prev_mask_.v[i] != 0) {
+    if (stayed) {
+      std::int64_t dx = 0, dy = 0;
+      if (have_prev_shear_) {
+        dx = clamp_proxy(static_cast<std::int64_t>(shear.x.v[i]) - prev_shear_.x.v[i]);
+        dy = clamp_proxy(static_cast<std::int64_t>(shear.y.v[i]) - prev_shear_.y.v[i]);
+      }
+      add_point(m_stayed, x, y, z);
+      sum_increment.add(x, y, z, dx, dy);
       ++common;
       common_dx += x - clamp64(prev_x_nm_.v[i], -kMaxPointNm, kMaxPointNm);
       common_dy += y - clamp64(prev_y_nm_.v[i], -kMaxPointNm, kMaxPointNm);
@@ -300,10 +313,12 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   out.velocity_differs = automatic && sticking;
   ContactMoments mv = m;
   sum_shear.store(mv);
-  (sticking ? sum_increment : sum_shear).store(m);
-  out.moments = m;
+  ContactMoments mi = m_stayed;
+  sum_increment.store(mi);
+  out.moments = sticking ? mi : mv;
   out.proxy_valid = !sticking || have_prev_shear_;
   out.proxy_scale = sticking ? displacement_scale : velocity_scale;
+  out.rotation_scale = sticking ? displacement_rotation_scale_ : rotation_scale_;
 
   // --- translation: contact-centroid planar displacement (paper Sec. IV-D), t_z = 0.
   const std::int64_t uni = m.n + prev_count_ - common;
@@ -352,7 +367,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   }
 
   // --- rotation: own-frame shear-only least squares, fixed 3x3 solve.
-  auto solve_rotation = [&](const ContactMoments& sums, double scale, Solve3Result& result) {
+  auto solve_rotation = [&](const ContactMoments& sums, double scale,
+                            const Eigen::Vector3d& axis_scale, Solve3Result& result) {
     const MomentSums ms = to_metric(sums, scale);
     Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
     Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
@@ -360,7 +376,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     Solve3Options opt = solve_options_;
     opt.lambda_abs = ms.n * lever_floor_m_ * lever_floor_m_;
     result = solve3(AtA, Atb, opt);
-    return Eigen::Vector3d(rotation_scale_.cwiseProduct(result.x));
+    return Eigen::Vector3d(axis_scale.cwiseProduct(result.x));
   };
   if (m.n > 0) {
     out.centroid_m = Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sx),
@@ -368,16 +384,22 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
                                                      static_cast<double>(m.sz)) *
                                      kNm) /
                      static_cast<double>(m.n);
-    out.omega = solve_rotation(m, out.proxy_scale, out.solve);
+  }
+  if (out.moments.n > 0) {
+    out.omega = solve_rotation(out.moments, out.proxy_scale, out.rotation_scale, out.solve);
     out.rotation_valid = out.proxy_valid && out.solve.valid;
   }
   if (out.velocity_differs) {
     out.velocity_moments = mv;
     out.velocity_proxy_scale = velocity_scale;
-    if (m.n > 0) out.velocity_omega = solve_rotation(mv, velocity_scale, out.velocity_solve);
+    out.velocity_rotation_scale = rotation_scale_;
+    if (m.n > 0) {
+      out.velocity_omega = solve_rotation(mv, velocity_scale, rotation_scale_, out.velocity_solve);
+    }
   } else {
     out.velocity_moments = out.moments;
     out.velocity_proxy_scale = out.proxy_scale;
+    out.velocity_rotation_scale = out.rotation_scale;
     out.velocity_omega = out.omega;
     out.velocity_solve = out.solve;
     out.velocity_translation = out.translation;

@@ -253,6 +253,82 @@ TEST(Motion, DisplacementModeNeedsOnePreviousFrame) {
   EXPECT_FALSE(run.frame(f.fz, f.w_now, f.shear_now).proxy_valid);
 }
 
+// The displacement proxy reads increments only where the cell was in Ω at both frames: a cell
+// that enters Ω holds whatever shear it had outside the patch (stale, untracked), and its first
+// increment would be that catch-up, read as motion at the largest lever.
+TEST(Motion, DisplacementIncrementsOnlyFromCellsInBothMasks) {
+  Calibration cal;
+  cal.velocity_proxy = VelocityProxy::kDisplacement;
+  RigidContactScene small, large;
+  small.radius_m = 3e-3;
+  large.radius_m = 4.5e-3;
+  small.omega_G = large.omega_G = Eigen::Vector3d(0.0, 0.0, 0.5);
+  const SyntheticSensorFrames fs = dsp_ref::render_rigid_contact(cal, small);
+  const SyntheticSensorFrames fl = dsp_ref::render_rigid_contact(cal, large);
+  Runner run(cal);
+  (void)run.frame(fs.fz, fl.w_prev, fl.shear_prev);
+  const GridMask before = run.cs->mask;
+  // The ring that enters Ω this frame carries a stale shear 20 times the true increment.
+  auto stale = std::make_unique<VectorField>(fl.shear_now);
+  run.det->detect(fl.fz, fl.w_now, [] {
+    GridMask v;
+    v.fill(1);
+    return v;
+  }(), *run.cs);
+  int entering = 0, both = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+    if (run.cs->mask.v[i] == 0) continue;
+    if (before.v[i] == 0) {
+      stale->x.v[i] *= 20;
+      stale->y.v[i] *= 20;
+      ++entering;
+    } else {
+      ++both;
+    }
+  }
+  ASSERT_GT(entering, 10);
+  SensorMotion m;
+  ASSERT_EQ(run.me->update(*run.cs, *stale, kDt, m), Status::kOk);
+  EXPECT_EQ(m.points, entering + both);
+  EXPECT_EQ(m.moments.n, both);  // the proxy's moments: the cells in both masks
+  ASSERT_TRUE(m.rotation_valid);
+  EXPECT_NEAR(m.omega.z(), 0.5, 1e-4);
+}
+
+// rotation_scale serves the velocity proxy; the displacement proxy's frames use rotation_scale
+// ⊙ displacement_rotation_ratio, and kAuto reports each reading with its own scales.
+TEST(Motion, DisplacementRotationRatioScalesOnlyTheDisplacementProxy) {
+  for (const VelocityProxy mode :
+       {VelocityProxy::kVelocity, VelocityProxy::kDisplacement, VelocityProxy::kAuto}) {
+    Calibration cal;
+    cal.velocity_proxy = mode;
+    cal.rotation_scale = {1.0, 1.0, 2.0};
+    cal.displacement_rotation_ratio = {1.0, 1.0, 0.25};
+    RigidContactScene sc;
+    sc.omega_G = Eigen::Vector3d(0.0, 0.0, 0.5);
+    Calibration render = cal;
+    render.velocity_proxy =
+        mode == VelocityProxy::kVelocity ? VelocityProxy::kVelocity : VelocityProxy::kDisplacement;
+    const SyntheticSensorFrames f = dsp_ref::render_rigid_contact(render, sc);
+    Runner run(cal);
+    const SensorMotion m = run.pair(f);
+    ASSERT_TRUE(m.rotation_valid) << static_cast<int>(mode);
+    if (mode == VelocityProxy::kVelocity) {
+      EXPECT_NEAR(m.omega.z(), 2.0 * 0.5, 2e-4);
+      EXPECT_FALSE(m.velocity_differs);
+    } else {
+      EXPECT_NEAR(m.omega.z(), 0.5 * 0.5, 1e-4) << static_cast<int>(mode);
+      EXPECT_EQ(m.rotation_scale, Eigen::Vector3d(1.0, 1.0, 0.5));
+    }
+    if (mode == VelocityProxy::kAuto) {
+      // Sticking: the velocity reading beside it, with rotation_scale alone.
+      EXPECT_TRUE(m.velocity_differs);
+      EXPECT_EQ(m.velocity_rotation_scale, Eigen::Vector3d(1.0, 1.0, 2.0));
+      EXPECT_EQ(velocity_reading(m).rotation_scale, Eigen::Vector3d(1.0, 1.0, 2.0));
+    }
+  }
+}
+
 TEST(Motion, OnsetAndLossGiveNoTranslationAndNoNan) {
   const Calibration cal;
   RigidContactScene sc;

@@ -93,6 +93,7 @@ void expect_same(const dsp::Calibration& a, const dsp::Calibration& b) {
   EXPECT_EQ(a.slip_smoothing_s, b.slip_smoothing_s);
   EXPECT_EQ(a.max_mask_change, b.max_mask_change);
   EXPECT_EQ(a.rotation_scale, b.rotation_scale);
+  EXPECT_EQ(a.displacement_rotation_ratio, b.displacement_rotation_ratio);
   EXPECT_EQ(a.translation_scale, b.translation_scale);
   EXPECT_EQ(a.moving_average_length, b.moving_average_length);
   EXPECT_EQ(a.solve_lambda_rel, b.solve_lambda_rel);
@@ -284,7 +285,7 @@ TEST(CalibrationFile, EveryPrefixAndByteFlipFailsCleanly) {
 TEST(CalibrationFile, EveryCalibrationFieldHasAKey) {
   // If dsp::Calibration gains a field, the file must learn it (this list is the file's).
   const auto keys = cfg::sensor_keys();
-  EXPECT_EQ(keys.size(), 30u);
+  EXPECT_EQ(keys.size(), 31u);
   EXPECT_EQ(keys.front(), "pixel_pitch_m");
   EXPECT_EQ(std::count(keys.begin(), keys.end(), "velocity_proxy"), 1);
   // The eight thresholds of the stick/slip detector (VelocityProxy::kAuto).

@@ -122,13 +122,17 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     PointSample s;
     s.q = c.q[i];
     const Eigen::Vector3d sv(shear_x[i], shear_y[i], 0.0);
+    // Increments only for cells also in the previous Ω (dsp::MotionEstimator's rule).
+    const bool stayed = prev_mask_[i] != 0;
     Eigen::Vector3d dv = Eigen::Vector3d::Zero();
-    if (have_prev_shear_)
+    if (have_prev_shear_ && stayed)
       dv = Eigen::Vector3d(shear_x[i] - prev_sx_[i], shear_y[i] - prev_sy_[i], 0.0);
     s.v = sv;
     shear_pts.push_back(s);
-    s.v = dv;
-    incr_pts.push_back(s);
+    if (stayed) {
+      s.v = dv;
+      incr_pts.push_back(s);
+    }
     sum_now += s.q;
     if (prev_mask_[i] != 0) {
       ++common;
@@ -137,10 +141,11 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   }
   out.points = static_cast<int>(shear_pts.size());
   out.contact = out.points > 0;
-  const double lambda_floor = out.points * cal_.solve_lever_floor_m * cal_.solve_lever_floor_m;
   auto solve = [&](const std::vector<PointSample>& pts) {
     const StackedSystem sys = stack_shear_rows(pts);
     const Eigen::Matrix3d AtA = sys.A.transpose() * sys.A;
+    const double lambda_floor =
+        static_cast<double>(pts.size()) * cal_.solve_lever_floor_m * cal_.solve_lever_floor_m;
     return solve_stacked(sys, cal_.solve_lambda_rel * AtA.trace() / 3.0 + lambda_floor);
   };
 
@@ -212,8 +217,14 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
 
   const Eigen::Vector3d tscale(cal_.translation_scale[0], cal_.translation_scale[1],
                                cal_.translation_scale[2]);
+  // Per-axis rotation scales of the velocity proxy, and of the displacement proxy (× ratio).
   const Eigen::Vector3d wscale(cal_.rotation_scale[0], cal_.rotation_scale[1],
                                cal_.rotation_scale[2]);
+  out.rotation_scale =
+      sticking ? Eigen::Vector3d(wscale.cwiseProduct(Eigen::Vector3d(
+                     cal_.displacement_rotation_ratio[0], cal_.displacement_rotation_ratio[1],
+                     cal_.displacement_rotation_ratio[2])))
+               : wscale;
   if (out.points > 0 && prev_count > 0) {
     const int uni = out.points + prev_count - common;
     const double change = 1.0 - static_cast<double>(common) / uni;
@@ -245,15 +256,15 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       out.velocity_translation_valid = true;
     }
   }
-  if (out.points > 0) {
-    out.centroid = sum_now / out.points;
-    out.omega = wscale.cwiseProduct(solve(out.samples));
-  }
+  if (out.points > 0) out.centroid = sum_now / out.points;
+  if (!out.samples.empty()) out.omega = out.rotation_scale.cwiseProduct(solve(out.samples));
   if (out.velocity_differs) {
     out.velocity_samples = shear_pts;
+    out.velocity_rotation_scale = wscale;
     if (out.points > 0) out.velocity_omega = wscale.cwiseProduct(solve(shear_pts));
   } else {
     out.velocity_samples = out.samples;
+    out.velocity_rotation_scale = out.rotation_scale;
     out.velocity_omega = out.omega;
     out.velocity_translation = out.translation;
     out.velocity_translation_valid = out.translation_valid;

@@ -133,7 +133,10 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
     auto samples = [&](const SensorMotionRef& s) -> const std::vector<PointSample>& {
       return velocity ? s.velocity_samples : s.samples;
     };
-    auto proxy_valid = [&](const SensorMotionRef& s) { return velocity ? true : s.proxy_valid; };
+    // A sensor enters ω with a defined proxy and at least one point (dsp::fuse's rule).
+    auto proxy_valid = [&](const SensorMotionRef& s) {
+      return (velocity || s.proxy_valid) && !samples(s).empty();
+    };
     auto translation = [&](const SensorMotionRef& s) {
       return velocity ? s.velocity_translation : s.translation;
     };
@@ -158,8 +161,8 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
           g.normal = e.R_GS * ps.normal;
           all.push_back(g);
         }
-        const auto& rs = cal_[static_cast<std::size_t>(i)].rotation_scale;
-        scale += e.R_GS * Eigen::Vector3d(rs[0], rs[1], rs[2]).asDiagonal() * e.R_GS.transpose();
+        const Eigen::Vector3d& rs = velocity ? s.velocity_rotation_scale : s.rotation_scale;
+        scale += e.R_GS * rs.asDiagonal() * e.R_GS.transpose();
         ++nw;
       }
       if (!all.empty()) {

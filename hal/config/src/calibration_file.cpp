@@ -82,6 +82,8 @@ const std::vector<Field>& fields() {
        &Calibration::rotation_scale},
       {"translation_scale", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
        &Calibration::translation_scale},
+      {"displacement_rotation_ratio", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
+       &Calibration::displacement_rotation_ratio},
       {"moving_average_length", Field::kInt, 1, dsp::kMaxMovingAverage, false, false, nullptr,
        &Calibration::moving_average_length},
       {"solve_lambda_rel", Field::kReal, 0.0, 1.0, false, false, &Calibration::solve_lambda_rel},

@@ -107,6 +107,11 @@ struct Calibration {
   // --- per-axis scales applied to this sensor's estimates, in its own frame. [0, 100]
   std::array<double, 3> rotation_scale{1.0, 1.0, 1.0};
   std::array<double, 3> translation_scale{1.0, 1.0, 1.0};
+  // Per-axis factor on rotation_scale for the frames that use the displacement proxy: the two
+  // proxies read the axes differently (the displacement proxy follows the gel's exact sticking
+  // kinematics, the velocity proxy a drag law), so one set of axis scales cannot serve both.
+  // 1 = the same scales. [0, 100]
+  std::array<double, 3> displacement_rotation_ratio{1.0, 1.0, 1.0};
 
   // --- temporal smoothing (paper Sec. IV-D moving average). [1, kMaxMovingAverage]
   int moving_average_length = 4;

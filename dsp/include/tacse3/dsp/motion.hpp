@@ -101,6 +101,7 @@ struct SensorMotion {
   bool velocity_differs = false;
   ContactMoments velocity_moments;
   double velocity_proxy_scale = 0.0;
+  Eigen::Vector3d velocity_rotation_scale = Eigen::Vector3d::Ones();
   Eigen::Vector3d velocity_omega = Eigen::Vector3d::Zero();
   Solve3Result velocity_solve;
   Eigen::Vector3d velocity_translation = Eigen::Vector3d::Zero();
@@ -151,6 +152,7 @@ class MotionEstimator {
   double c_displacement_ = 0.0;
   double max_mask_change_ = 0.0;
   Eigen::Vector3d rotation_scale_ = Eigen::Vector3d::Ones();
+  Eigen::Vector3d displacement_rotation_scale_ = Eigen::Vector3d::Ones();  // ⊙ ratio
   Eigen::Vector3d translation_scale_ = Eigen::Vector3d::Ones();
   Solve3Options solve_options_;
   double lever_floor_m_ = 0.0;

@@ -46,6 +46,7 @@ struct SensorMotionRef {
   bool translation_valid = false;
   int translation_source = 0;                       // as dsp::TranslationSource
   Eigen::Vector3d omega = Eigen::Vector3d::Zero();  // scaled, own-frame stacked LS
+  Eigen::Vector3d rotation_scale = Eigen::Vector3d::Ones();  // this frame's proxy's scales
   bool proxy_valid = false;
   // kAuto detector, as dsp::SensorMotion.
   bool slipping = false;
@@ -58,6 +59,7 @@ struct SensorMotionRef {
   bool velocity_differs = false;
   std::vector<PointSample> velocity_samples;
   Eigen::Vector3d velocity_omega = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_rotation_scale = Eigen::Vector3d::Ones();
   Eigen::Vector3d velocity_translation = Eigen::Vector3d::Zero();
   bool velocity_translation_valid = false;
 };
