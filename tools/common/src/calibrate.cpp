@@ -868,7 +868,8 @@ std::string format_report(const CalibrateReport& rep) {
   o += line;
   const auto& p = rep.calibration.paper[0];
   std::snprintf(line, sizeof(line),
-                "rotation scales: joint (%.4g, %.4g, %.4g), displacement proxy x (%.4g, %.4g, %.4g), "
+                "rotation scales: joint (%.4g, %.4g, %.4g), displacement proxy ratio "
+                "(%.4g, %.4g, %.4g), "
                 "paper (%.4g, %.4g, %.4g); "
                 "translation scales: joint (%.4g, %.4g), paper (%.4g, %.4g)\n",
                 c.rotation_scale[0], c.rotation_scale[1], c.rotation_scale[2],
