@@ -181,6 +181,13 @@ Status DualPipeline::set_calibration(const std::array<Calibration, 2>& cal) noex
     (void)average_.set_length(cal[0].moving_average_length);
   }
   payback_.configure(cal[0].slip_catchup_frames);
+  // Entering or leaving kAuto on either sensor: the pending payback belongs to the old mode.
+  for (std::size_t i = 0; i < cal.size(); ++i) {
+    if ((cal[i].velocity_proxy == VelocityProxy::kAuto) !=
+        (cal_[i].velocity_proxy == VelocityProxy::kAuto)) {
+      payback_.reset();
+    }
+  }
   cal_ = cal;
   return Status::kOk;
 }
@@ -277,6 +284,7 @@ void DualPipeline::tare() noexcept {
 
 void DualPipeline::reset_pose() noexcept {
   integrator_.reset();
+  payback_.reset();  // a pending payback belongs to the motion before the new origin
 }
 
 Status DualPipeline::set_finger_separation(double separation_m) noexcept {

@@ -135,7 +135,7 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
     };
     // A sensor enters ω with a defined proxy and at least one point (dsp::fuse's rule).
     auto proxy_valid = [&](const SensorMotionRef& s) {
-      return (velocity || s.proxy_valid) && !samples(s).empty();
+      return ((velocity && s.velocity_differs) || s.proxy_valid) && !samples(s).empty();
     };
     auto translation = [&](const SensorMotionRef& s) {
       return velocity ? s.velocity_translation : s.translation;

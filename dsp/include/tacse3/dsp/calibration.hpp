@@ -15,12 +15,14 @@ enum class VelocityProxy : std::uint8_t {
   // ṽ = c_velocity · shear. Suits the sliding regime.
   kVelocity = 0,
   // The increment of the shear field between consecutive frames is the contact displacement,
-  // ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt. Exact kinematics while the contact sticks.
+  // ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt, over the cells in both frames' Ω. Exact
+  // kinematics while the contact sticks.
   kDisplacement = 1,
   // Per frame and per sensor: a stick/slip detector (motion.hpp, docs/dsp.md "Stick/slip
   // detector") picks kDisplacement while the contact sticks and kVelocity while it slips, with
-  // the thresholds below. The velocity proxy's deficit accumulated while a slip still looked like
-  // a stick is paid back over slip_catchup_frames once the slip is detected (no pose jump).
+  // the thresholds below. What the velocity proxy would have added while a slip still looked like
+  // a stick is paid back in the fused twist over slip_catchup_frames once the slip is detected
+  // (no pose jump; dsp::SlipPayback).
   kAuto = 2,
 };
 
@@ -87,12 +89,13 @@ struct Calibration {
   double slip_exit_fraction = 0.25;
   double stick_rest_speed_m_s = 0.05e-3;
   // A sticking contact whose shear content stayed at rest (|dX|/Δt < stick_rest_speed_m_s) for
-  // stick_confirm_s is confirmed stuck and its pending velocity-proxy deficit is dropped: a slide
-  // relaxes within a few lag times of the gel, a stuck contact holds its shear. [0, 10] s.
+  // stick_confirm_s is confirmed stuck; once every sensor in contact is, the pending payback is
+  // dropped: a slide relaxes within a few lag times of the gel, a stuck contact holds its shear.
+  // [0, 10] s.
   double stick_confirm_s = 1.0;
   // Frames over which the deficit (what the velocity proxy would have added while the slip still
   // looked like a stick) is paid back after a slip onset, so the pose catches up without a jump.
-  // [1, 1000].
+  // The dual pipeline uses the left sensor's value (one payback for the fused twist). [1, 1000].
   int slip_catchup_frames = 12;
   // Time constant of the smoothing of X (s): the per-frame noise of the shear field's rigid
   // content is ~10 µm, the gel's lag (which a slide's relaxation follows) ~50 ms. [0, 1].

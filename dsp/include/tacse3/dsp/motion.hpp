@@ -73,7 +73,9 @@ enum class TranslationSource : std::uint8_t {
 struct SensorMotion {
   bool contact = false;
   int points = 0;
-  ContactMoments moments;    // this frame's Ω, sensor frame
+  // This frame's proxy moments, sensor frame: over Ω (velocity proxy) or over Ω_t ∩ Ω_{t−1}
+  // (displacement proxy, the cells with an increment).
+  ContactMoments moments;
   double proxy_scale = 0.0;  // (m/s) per Q16 LSB of the proxy in `moments`
   bool proxy_valid = false;  // false on the first displacement-mode frame after reset
   Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();  // 3D centroid of q over Ω (m)
@@ -109,11 +111,12 @@ struct SensorMotion {
 };
 
 // `m` as kVelocity would have read the frame: its velocity_* fields in place of the chosen
-// reading (proxy always defined). Used to fuse the velocity reading beside the chosen one.
+// reading (proxy defined with contact) while velocity_differs; otherwise `m` itself. Used to fuse
+// the velocity reading beside the chosen one.
 SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 
-// Per-sensor motion stage. State: previous mask, positions, centroid sums and shear field
-// (≈ 25 KB), no heap.
+// Per-sensor motion stage. State: previous mask, positions, centroid sums, shear field and the
+// detector's few scalars; no heap.
 //  - Translation (paper Sec. IV-D "contact-centroid planar translation"): c_t = mean of the
 //    current positions over Ω_t; t = (c_t − c_{t−1}) / Δt, t_z = 0. Spike rules:
 //      * onset (Ω_{t−1} empty) or loss (Ω_t empty): t = 0, translation_valid = false;
@@ -124,10 +127,12 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 //        would move the centroid without any object motion, so t is the mean displacement of
 //        the material points present in both masks (exact while the contact sticks);
 //      * otherwise the mask-centroid displacement (also follows a sliding patch).
-//  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear; kDisplacement
-//    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt, the previous shear kept per sensor.
-//  - Rotation: int64 moments over Ω, then in double the own-frame normal equations and
-//    solve3 with λ = λ_rel tr/3 + N · lever_floor².
+//  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear over Ω; kDisplacement
+//    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt over Ω_t ∩ Ω_{t−1}, the previous shear
+//    kept per sensor.
+//  - Rotation: int64 moments over the proxy's cells, then in double the own-frame normal
+//    equations and solve3 with λ = λ_rel tr/3 + N · lever_floor²; per-axis scales
+//    rotation_scale (velocity proxy) or rotation_scale ⊙ displacement_rotation_ratio.
 //  - kAuto (per frame): both proxies' moments are summed in the same pass; the stick/slip
 //    detector (Calibration, docs/dsp.md) picks one. While sticking, the velocity proxy's reading
 //    (its ω and the sliding translation rule) is reported beside the displacement proxy's; the
