@@ -260,6 +260,12 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   out.points = static_cast<int>(m.n);
   out.contact = m.n > 0;
 
+  // The two proxies' moments: the shear over Ω (velocity) and its increment over Ω_t ∩ Ω_{t−1}.
+  ContactMoments mv = m;
+  sum_shear.store(mv);
+  ContactMoments mi = m_stayed;
+  sum_increment.store(mi);
+
   // --- kAuto: the stick/slip detector on the rigid-body content of the shear and its increment.
   // The proxy of this frame is the one decided up to the previous frame.
   const bool sticking = automatic ? !slipping_ : mode_ == VelocityProxy::kDisplacement;
@@ -268,9 +274,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       reset_detector();  // no contact: the next contact starts sticking (static friction first)
     } else {
       // Planar rigid-body content of the shear read as a contact displacement, smoothed.
-      ContactMoments ms = m;
-      sum_shear.store(ms);
-      const Eigen::Vector3d raw = planar_content(ms, c_displacement_ * kQ16Lsb);
+      const Eigen::Vector3d raw = planar_content(mv, c_displacement_ * kQ16Lsb);
       const Eigen::Vector3d before = content_;
       content_ =
           have_content_
@@ -311,10 +315,6 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
 
   // Final proxy of this frame, and (kAuto while sticking) the velocity proxy's reading beside it.
   out.velocity_differs = automatic && sticking;
-  ContactMoments mv = m;
-  sum_shear.store(mv);
-  ContactMoments mi = m_stayed;
-  sum_increment.store(mi);
   out.moments = sticking ? mi : mv;
   out.proxy_valid = !sticking || have_prev_shear_;
   out.proxy_scale = sticking ? displacement_scale : velocity_scale;
