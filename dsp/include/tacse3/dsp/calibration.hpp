@@ -103,9 +103,14 @@ struct Calibration {
 
   // --- translation (contact-centroid displacement, paper Sec. IV-D)
   // If the mask changes by more than this fraction between frames (1 − Jaccard index), the
-  // mask-centroid displacement is replaced by the mean displacement of the material points in
-  // both masks, so area changes do not produce spikes. [0, 1]
-  double max_mask_change = 0.3;
+  // sliding rule's mask-centroid displacement is replaced by the mean displacement of the
+  // material points in both masks, so area changes do not produce spikes. [0, 1]; 1 = off, the
+  // default: in a slide Ω advances in bursts (a third of its cells in one frame) and the gate
+  // dropped that motion (the material points stand still while the object slides), while the
+  // centroid differences telescope (docs/dsp.md §4.1). A sticking contact (kDisplacement, kAuto
+  // while sticking) reads the material points anyway. Worth setting (e.g. 0.3) only with
+  // kVelocity on contacts dominated by pressing rather than sliding.
+  double max_mask_change = 1.0;
 
   // --- per-axis scales applied to this sensor's estimates, in its own frame. [0, 100]
   std::array<double, 3> rotation_scale{1.0, 1.0, 1.0};

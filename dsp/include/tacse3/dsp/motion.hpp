@@ -123,9 +123,10 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 //      * kDisplacement proxy (the contact sticks): t is the mean displacement of the material
 //        points present in both masks — exact kinematics, and blind to Ω creeping backwards
 //        when a tangential load stretches the gel behind the patch (𝒢 reads that as expansion);
-//      * if 1 − |Ω_t ∩ Ω_{t−1}| / |Ω_t ∪ Ω_{t−1}| > max_mask_change, cells entering/leaving
-//        would move the centroid without any object motion, so t is the mean displacement of
-//        the material points present in both masks (exact while the contact sticks);
+//      * if 1 − |Ω_t ∩ Ω_{t−1}| / |Ω_t ∪ Ω_{t−1}| > max_mask_change (off by default), cells
+//        entering/leaving would move the centroid without any object motion, so t is the mean
+//        displacement of the material points present in both masks (exact while the contact
+//        sticks; zero in a slide, hence off by default);
 //      * otherwise the mask-centroid displacement (also follows a sliding patch).
 //  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear over Ω; kDisplacement
 //    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt over Ω_t ∩ Ω_{t−1}, the previous shear
