@@ -785,6 +785,17 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
                           " in the recordings; its scale stays 1");
     }
   }
+  // The proxy whose translation is closer to the truth (the two proxies measure translation
+  // differently: contact centroid vs common material points). The translation scales are fitted
+  // on it and the report's translation error is read from it.
+  auto translation_run = [&](std::size_t r, bool paper) -> const RunOutput& {
+    const std::size_t base_idx = paper ? 2 : 0;
+    const RunOutput& ra = out2[r][base_idx];
+    const RunOutput& rb = out2[r][base_idx + 1];
+    const bool use_b =
+        (rb.final_pose.p - truth_p[r]).norm() < (ra.final_pose.p - truth_p[r]).norm();
+    return use_b ? rb : ra;
+  };
   // Translation scales (x, y; t_z = 0) from recordings that translate.
   auto fit_translation = [&](bool paper, const char* what) {
     std::array<double, 3> st{1.0, 1.0, 1.0};
@@ -792,14 +803,7 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
       double num = 0.0, den = 0.0;
       for (std::size_t r = 0; r < n; ++r) {
         if (std::abs(truth_p[r](ax)) < 1e-3) continue;
-        // The proxy whose translation is closer to the truth (the two proxies measure
-        // translation differently: contact centroid vs common material points).
-        const std::size_t base_idx = paper ? 2 : 0;
-        const RunOutput& ra = out2[r][base_idx];
-        const RunOutput& rb = out2[r][base_idx + 1];
-        const bool use_b =
-            (rb.final_pose.p - truth_p[r]).norm() < (ra.final_pose.p - truth_p[r]).norm();
-        const double e = (use_b ? rb : ra).final_pose.p(ax);
+        const double e = translation_run(r, paper).final_pose.p(ax);
         num += e * truth_p[r](ax);
         den += e * e;
       }
@@ -831,7 +835,7 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     f.after_other_deg =
         rotation_error_deg(out2[r][static_cast<std::size_t>(1 - fit.p.mode[r])].final_pose.q, tp.q);
     f.after_paper_deg = geodesic_deg(ap.cwiseProduct(run_of(r, true).rot_integral), data[r].theta);
-    const Eigen::Vector3d pe = run_of(r, false).final_pose.p.cwiseProduct(
+    const Eigen::Vector3d pe = translation_run(r, false).final_pose.p.cwiseProduct(
         Eigen::Vector3d(st_joint[0], st_joint[1], st_joint[2]));
     f.translation_after_mm = (pe - truth_p[r]).norm() * 1e3;
   }

@@ -33,7 +33,9 @@ struct RecordingFit {
   double after_deg = 0.0;             // joint, fitted calibration, that proxy (measured)
   double after_other_deg = 0.0;       // joint, fitted calibration, the other proxy (measured)
   double after_paper_deg = 0.0;       // paper fusion, fitted paper scales (linear prediction)
-  double translation_after_mm = 0.0;  // joint, fitted (translation scales applied linearly)
+  // joint, fitted (translation scales applied linearly), with the proxy whose translation is
+  // closer to the truth (the one the translation scales are fitted on)
+  double translation_after_mm = 0.0;
 };
 
 struct CalibrateReport {
