@@ -128,7 +128,7 @@ void fuse_joint(const std::array<const SensorMotion*, 2>& s, const FusionConfig&
     if (!enters_translation(m)) continue;
     const SensorExtrinsics& e = cfg.extrinsics[static_cast<std::size_t>(i)];
     v_mean += e.R_GS * m->translation;
-    c_mean += e.R_GS * m->centroid_m + e.p_GS(separation_m);
+    c_mean += e.R_GS * m->translation_point_m + e.p_GS(separation_m);
     ++nt;
     out.translation_sensors |= static_cast<std::uint8_t>(1u << i);
   }

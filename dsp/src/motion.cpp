@@ -141,6 +141,7 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept {
   v.rotation_valid = v.proxy_valid && m.velocity_solve.valid;
   v.translation = m.velocity_translation;
   v.translation_valid = m.velocity_translation_valid;
+  v.translation_point_m = m.velocity_translation_point_m;
   v.velocity_differs = false;
   return v;
 }
@@ -197,6 +198,9 @@ void MotionEstimator::reset() noexcept {
   prev_count_ = 0;
   prev_sx_ = 0;
   prev_sy_ = 0;
+  prev_sz_ = 0;
+  prev_sxz_ = 0;
+  prev_syz_ = 0;
   prev_shear_.x.fill(0);
   prev_shear_.y.fill(0);
   have_prev_shear_ = false;
@@ -321,6 +325,26 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   out.rotation_scale = sticking ? displacement_rotation_scale_ : rotation_scale_;
 
   // --- translation: contact-centroid planar displacement (paper Sec. IV-D), t_z = 0.
+  if (m.n > 0) {
+    out.centroid_m = Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sx),
+                                                     static_cast<double>(m.sy),
+                                                     static_cast<double>(m.sz)) *
+                                     kNm) /
+                     static_cast<double>(m.n);
+  }
+  // The sliding rule's centroid is weighted by the contact points' height z (the indentation
+  // estimate): cells at the rim of Ω carry z ≈ 0, so the cells that flicker in and out of Ω
+  // there, and those the hysteresis keeps in Ω after the patch has moved on, hardly move it
+  // (docs/accuracy.md item 5). Without any height (flat contact, height_gain 0) the plain mean.
+  const bool weighted = m.sz > 0 && prev_sz_ > 0;
+  Eigen::Vector3d slide_point = out.centroid_m;
+  if (m.sz > 0) {
+    slide_point = Eigen::Vector3d(static_cast<double>(m.sxz), static_cast<double>(m.syz),
+                                  static_cast<double>(m.szz)) *
+                  kNm / static_cast<double>(m.sz);
+  }
+  if (!weighted) slide_point = out.centroid_m;
+  out.translation_point_m = out.centroid_m;
   const std::int64_t uni = m.n + prev_count_ - common;
   out.mask_change = uni > 0 ? 1.0 - static_cast<double>(common) / static_cast<double>(uni) : 1.0;
   if (m.n > 0 && prev_count_ > 0) {
@@ -335,9 +359,19 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
           kNm;
     }
     if (out.mask_change <= max_mask_change_) {
-      const double nt = static_cast<double>(m.n), np = static_cast<double>(prev_count_);
-      slide_disp.x() = (static_cast<double>(m.sx) / nt - static_cast<double>(prev_sx_) / np) * kNm;
-      slide_disp.y() = (static_cast<double>(m.sy) / nt - static_cast<double>(prev_sy_) / np) * kNm;
+      if (weighted) {
+        const double wt = static_cast<double>(m.sz), wp = static_cast<double>(prev_sz_);
+        slide_disp.x() =
+            (static_cast<double>(m.sxz) / wt - static_cast<double>(prev_sxz_) / wp) * kNm;
+        slide_disp.y() =
+            (static_cast<double>(m.syz) / wt - static_cast<double>(prev_syz_) / wp) * kNm;
+      } else {
+        const double nt = static_cast<double>(m.n), np = static_cast<double>(prev_count_);
+        slide_disp.x() =
+            (static_cast<double>(m.sx) / nt - static_cast<double>(prev_sx_) / np) * kNm;
+        slide_disp.y() =
+            (static_cast<double>(m.sy) / nt - static_cast<double>(prev_sy_) / np) * kNm;
+      }
       slide_source = TranslationSource::kCentroid;
     } else if (common > 0) {
       slide_disp = common_disp;
@@ -356,6 +390,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       disp = slide_disp;
       out.translation_source = slide_source;
       out.translation_valid = true;
+      if (slide_source == TranslationSource::kCentroid) out.translation_point_m = slide_point;
     }
     out.translation =
         translation_scale_.cwiseProduct(Eigen::Vector3d(disp.x(), disp.y(), 0.0) / dt_s);
@@ -363,6 +398,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       out.velocity_translation = translation_scale_.cwiseProduct(
           Eigen::Vector3d(slide_disp.x(), slide_disp.y(), 0.0) / dt_s);
       out.velocity_translation_valid = true;
+      out.velocity_translation_point_m =
+          slide_source == TranslationSource::kCentroid ? slide_point : out.centroid_m;
     }
   }
 
@@ -378,13 +415,6 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     result = solve3(AtA, Atb, opt);
     return Eigen::Vector3d(axis_scale.cwiseProduct(result.x));
   };
-  if (m.n > 0) {
-    out.centroid_m = Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sx),
-                                                     static_cast<double>(m.sy),
-                                                     static_cast<double>(m.sz)) *
-                                     kNm) /
-                     static_cast<double>(m.n);
-  }
   if (out.moments.n > 0) {
     out.omega = solve_rotation(out.moments, out.proxy_scale, out.rotation_scale, out.solve);
     out.rotation_valid = out.proxy_valid && out.solve.valid;
@@ -404,6 +434,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     out.velocity_solve = out.solve;
     out.velocity_translation = out.translation;
     out.velocity_translation_valid = out.translation_valid;
+    out.velocity_translation_point_m = out.translation_point_m;
   }
 
   // --- state for the next frame.
@@ -413,6 +444,9 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   prev_count_ = m.n;
   prev_sx_ = m.sx;
   prev_sy_ = m.sy;
+  prev_sz_ = m.sz;
+  prev_sxz_ = m.sxz;
+  prev_syz_ = m.syz;
   prev_shear_ = shear;
   have_prev_shear_ = true;
   return Status::kOk;

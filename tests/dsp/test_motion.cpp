@@ -164,8 +164,25 @@ TEST(Motion, CentroidTranslationMatchesAnalyticMotion) {
                                         ? TranslationSource::kCentroid
                                         : TranslationSource::kCommonPoints);
     EXPECT_EQ(m.mask_change, 0.0);
-    // Stick: every contact point moved by v(q)·dt, so the centroid moved by v(centroid)·dt.
-    const Eigen::Vector3d c = dsp_ref::centroid(f.points_G);
+    // Stick: every contact point moved by v(q)·dt, so a centroid with fixed weights moved by
+    // v(centroid)·dt: the plain mean for the material points (displacement proxy), the mean
+    // weighted by the height z for the sliding rule (velocity proxy; the heights come from f^z,
+    // the same in both frames).
+    Eigen::Vector3d c = dsp_ref::centroid(f.points_G);
+    if (mode == VelocityProxy::kVelocity) {
+      Eigen::Vector3d zq = Eigen::Vector3d::Zero();
+      double zs = 0.0;
+      for (const auto& p : f.points_G) {
+        zq += p.q.z() * p.q;
+        zs += p.q.z();
+      }
+      ASSERT_GT(zs, 0.0);
+      // The weighting is visible at this test's bound: on the coarse grid the two centroids
+      // differ, and ω × Δc moves the expected translation by more than the 3e-7 m/s tolerance.
+      const Eigen::Vector3d plain = c;
+      c = zq / zs;
+      EXPECT_GT(sc.omega_G.cross(c - plain).head<2>().norm(), 3e-7);
+    }
     Eigen::Vector3d expect = sc.omega_G.cross(c) + sc.t_G;
     expect.z() = 0.0;
     // Positions are Q16 working px (≤ 2^-17 · 150 µm = 1.1 nm per point) and 1 nm integers:
@@ -402,7 +419,7 @@ TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
   // 10 mm slides (a third of the cells enter or leave in one frame): the patch stands still for
   // three frames, then jumps 1.5 mm. The gel does not move (w = 0: it slides). With the default
   // calibration the per-frame centroid differences telescope, so their sum is the centroid's
-  // whole displacement (9 mm). With the old gate at 0.3 every jump frame read the material
+  // whole displacement (9 mm; the centroid weighted by the points' height, the sliding rule's). With the old gate at 0.3 every jump frame read the material
   // points (zero in a slide) and the motion was lost (docs/accuracy.md item 5).
   for (double gate : {1.0, 0.3}) {
     Calibration cal;
@@ -422,14 +439,24 @@ TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
       still.y.fill(0);
       const SensorMotion m = run.frame(f.fz, still, still);
       ASSERT_TRUE(m.contact);
+      // The sliding rule's centroid: the mean of the contact points weighted by their height.
+      Eigen::Vector3d zq = Eigen::Vector3d::Zero();
+      double zs = 0.0;
+      for (std::size_t i = 0; i < run.cs->mask.v.size(); ++i) {
+        if (run.cs->mask.v[i] == 0) continue;
+        const double z = run.cs->z_nm.v[i];
+        zq += z * Eigen::Vector3d(run.cs->x_nm.v[i], run.cs->y_nm.v[i], 0.0) * 1e-9;
+        zs += z;
+      }
+      ASSERT_GT(zs, 0.0);
       if (k == 0) {
-        first = m.centroid_m;
+        first = zq / zs;
         continue;
       }
       ASSERT_TRUE(m.translation_valid) << k;
       if (m.mask_change > 0.3) ++jumps;
       sum += m.translation * kDt;
-      last = m.centroid_m;
+      last = zq / zs;
     }
     ASSERT_EQ(jumps, 6);  // every fourth frame
     const Eigen::Vector3d whole(last.x() - first.x(), last.y() - first.y(), 0.0);
@@ -441,6 +468,46 @@ TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
       EXPECT_LT(std::abs(sum.x()), 1e-6);  // every 1.5 mm jump lost
     }
   }
+}
+
+TEST(Motion, SlidingCentroidIsWeightedByHeightSoAHysteresisTrailHardlyMovesIt) {
+  // A patch slides 6 mm along x in one step (kVelocity, sliding rule). Where it was, f^z stays
+  // at 1.5 τ_off: above the threshold that keeps last frame's cells in Ω, below the one that
+  // admits new cells, the trail the simulator's slides leave (docs/accuracy.md item 5). Those
+  // cells stay in Ω, at a small height. The plain mask centroid is pulled back by them; the
+  // height-weighted one, which the sliding rule reads, much less.
+  Calibration cal;
+  cal.velocity_proxy = VelocityProxy::kVelocity;
+  RigidContactScene before, after;
+  before.contact_centre_G = Eigen::Vector3d(-3e-3, 0.0, 0.0);
+  after.contact_centre_G = Eigen::Vector3d(3e-3, 0.0, 0.0);
+  const SyntheticSensorFrames f0 = dsp_ref::render_rigid_contact(cal, before);
+  const SyntheticSensorFrames f1 = dsp_ref::render_rigid_contact(cal, after);
+  ScalarField trail = f1.fz;
+  const std::int32_t weak = to_q32<16>(1.5 * cal.contact_tau_off);
+  int trail_cells = 0;
+  for (std::size_t i = 0; i < trail.v.size(); ++i) {
+    if (f0.fz.v[i] > to_q32<16>(cal.contact_tau_on) && f1.fz.v[i] < weak) {
+      trail.v[i] = weak;
+      ++trail_cells;
+    }
+  }
+  ASSERT_GT(trail_cells, 30);
+  VectorField still;
+  still.x.fill(0);
+  still.y.fill(0);
+  Runner run(cal);
+  const SensorMotion m0 = run.frame(f0.fz, still, still);
+  const SensorMotion m1 = run.frame(trail, still, still);
+  ASSERT_TRUE(m1.translation_valid);
+  ASSERT_EQ(m1.translation_source, TranslationSource::kCentroid);
+  // Truth: the patch moved 6 mm. The plain centroid reads little more than half of it.
+  const double plain_error = std::abs((m1.centroid_m.x() - m0.centroid_m.x()) - 6e-3);
+  const double weighted_error = std::abs(m1.translation.x() * kDt - 6e-3);
+  EXPECT_GT(plain_error, 2.5e-3);
+  EXPECT_LT(weighted_error, 0.5 * plain_error) << weighted_error;
+  // translation_point_m is the weighted centroid, on the patch side of the plain one.
+  EXPECT_GT(m1.translation_point_m.x(), m1.centroid_m.x() + 1e-3);
 }
 
 TEST(Motion, DegenerateContactsAreFlaggedAndFinite) {

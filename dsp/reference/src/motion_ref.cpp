@@ -110,6 +110,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   }
   int prev_count = 0, common = 0;
   Eigen::Vector3d sum_now = Eigen::Vector3d::Zero(), sum_prev = Eigen::Vector3d::Zero();
+  // Height-weighted sums for the sliding rule's centroid (dsp::MotionEstimator's rule).
+  Eigen::Vector3d zsum_now = Eigen::Vector3d::Zero(), zsum_prev = Eigen::Vector3d::Zero();
+  double z_now = 0.0, z_prev = 0.0;
   Eigen::Vector3d sum_common = Eigen::Vector3d::Zero();
   // Per point: shear (velocity reading), increment (displacement reading).
   std::vector<PointSample> shear_pts, incr_pts;
@@ -117,6 +120,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     if (prev_mask_[i] != 0) {
       ++prev_count;
       sum_prev += prev_q_[i];
+      zsum_prev += prev_q_[i].z() * prev_q_[i];
+      z_prev += prev_q_[i].z();
     }
     if (c.mask[i] == 0) continue;
     PointSample s;
@@ -134,6 +139,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       incr_pts.push_back(s);
     }
     sum_now += s.q;
+    zsum_now += s.q.z() * s.q;
+    z_now += s.q.z();
     if (prev_mask_[i] != 0) {
       ++common;
       sum_common += s.q - prev_q_[i];
@@ -225,6 +232,11 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
                      cal_.displacement_rotation_ratio[0], cal_.displacement_rotation_ratio[1],
                      cal_.displacement_rotation_ratio[2])))
                : wscale;
+  if (out.points > 0) out.centroid = sum_now / out.points;
+  // The sliding rule's centroid, weighted by the points' height (dsp::MotionEstimator's rule).
+  const bool weighted = z_now > 0.0 && z_prev > 0.0;
+  const Eigen::Vector3d slide_point = weighted ? Eigen::Vector3d(zsum_now / z_now) : out.centroid;
+  out.translation_point = out.centroid;
   if (out.points > 0 && prev_count > 0) {
     const int uni = out.points + prev_count - common;
     const double change = 1.0 - static_cast<double>(common) / uni;
@@ -232,7 +244,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     int slide_source = 0;
     if (common > 0) common_d = sum_common / common;
     if (change <= cal_.max_mask_change) {
-      slide = sum_now / out.points - sum_prev / prev_count;
+      slide = weighted ? Eigen::Vector3d(zsum_now / z_now - zsum_prev / z_prev)
+                       : Eigen::Vector3d(sum_now / out.points - sum_prev / prev_count);
       slide_source = 1;
     } else if (common > 0) {
       slide = common_d;
@@ -247,6 +260,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       d = slide;
       out.translation_source = slide_source;
       out.translation_valid = true;
+      if (slide_source == 1) out.translation_point = slide_point;
     }
     d.z() = 0.0;
     out.translation = tscale.cwiseProduct(d / dt);
@@ -254,9 +268,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       slide.z() = 0.0;
       out.velocity_translation = tscale.cwiseProduct(slide / dt);
       out.velocity_translation_valid = true;
+      out.velocity_translation_point = slide_source == 1 ? slide_point : out.centroid;
     }
   }
-  if (out.points > 0) out.centroid = sum_now / out.points;
   if (!out.samples.empty()) out.omega = out.rotation_scale.cwiseProduct(solve(out.samples));
   if (out.velocity_differs) {
     out.velocity_samples = shear_pts;
@@ -268,6 +282,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     out.velocity_omega = out.omega;
     out.velocity_translation = out.translation;
     out.velocity_translation_valid = out.translation_valid;
+    out.velocity_translation_point = out.translation_point;
   }
   prev_mask_ = c.mask;
   prev_q_ = c.q;

@@ -182,7 +182,9 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
         if (!ok[static_cast<std::size_t>(i)] || !s.contact || !translation_valid(s)) continue;
         const dsp::SensorExtrinsics& e = fc.extrinsics[static_cast<std::size_t>(i)];
         v_mean += e.R_GS * translation(s);
-        c_mean += e.R_GS * s.centroid + e.p_GS(config_.finger_separation_m);
+        const Eigen::Vector3d& point =
+            velocity ? s.velocity_translation_point : s.translation_point;
+        c_mean += e.R_GS * point + e.p_GS(config_.finger_separation_m);
         ++nt;
       }
       if (nt > 0) {

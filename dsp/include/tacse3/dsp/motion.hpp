@@ -79,6 +79,10 @@ struct SensorMotion {
   double proxy_scale = 0.0;  // (m/s) per Q16 LSB of the proxy in `moments`
   bool proxy_valid = false;  // false on the first displacement-mode frame after reset
   Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();  // 3D centroid of q over Ω (m)
+  // The contact point whose velocity `translation` is (m): the height-weighted centroid
+  // Σ z q / Σ z for the sliding rule (kCentroid), centroid_m otherwise. The fusion refers the
+  // translation to G's origin from here (t = v − ω × point).
+  Eigen::Vector3d translation_point_m = Eigen::Vector3d::Zero();
   // Contact-centroid velocity (m/s), t_z = 0, translation_scale applied.
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   bool translation_valid = false;
@@ -108,6 +112,7 @@ struct SensorMotion {
   Solve3Result velocity_solve;
   Eigen::Vector3d velocity_translation = Eigen::Vector3d::Zero();
   bool velocity_translation_valid = false;
+  Eigen::Vector3d velocity_translation_point_m = Eigen::Vector3d::Zero();
 };
 
 // `m` as kVelocity would have read the frame: its velocity_* fields in place of the chosen
@@ -117,8 +122,10 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 
 // Per-sensor motion stage. State: previous mask, positions, centroid sums, shear field and the
 // detector's few scalars; no heap.
-//  - Translation (paper Sec. IV-D "contact-centroid planar translation"): c_t = mean of the
-//    current positions over Ω_t; t = (c_t − c_{t−1}) / Δt, t_z = 0. Spike rules:
+//  - Translation (paper Sec. IV-D "contact-centroid planar translation"): c_t = centroid of the
+//    current positions over Ω_t, weighted by their height z (the indentation estimate, so the
+//    rim cells that flicker in and out of Ω hardly move it; the plain mean if Σ z = 0);
+//    t = (c_t − c_{t−1}) / Δt, t_z = 0. Spike rules:
 //      * onset (Ω_{t−1} empty) or loss (Ω_t empty): t = 0, translation_valid = false;
 //      * kDisplacement proxy (the contact sticks): t is the mean displacement of the material
 //        points present in both masks — exact kinematics, and blind to Ω creeping backwards
@@ -169,6 +176,9 @@ class MotionEstimator {
   std::int64_t prev_count_ = 0;
   std::int64_t prev_sx_ = 0;
   std::int64_t prev_sy_ = 0;
+  std::int64_t prev_sz_ = 0;   // Σ z over Ω_{t−1} (weights of the sliding rule's centroid)
+  std::int64_t prev_sxz_ = 0;  // Σ x z
+  std::int64_t prev_syz_ = 0;  // Σ y z
   VectorField prev_shear_;
   bool have_prev_shear_ = false;
 

@@ -42,6 +42,8 @@ struct SensorMotionRef {
   int points = 0;
   std::vector<PointSample> samples;  // sensor frame, proxy in m/s
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  // Where `translation` applies (dsp::SensorMotion::translation_point_m).
+  Eigen::Vector3d translation_point = Eigen::Vector3d::Zero();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();  // scaled, t_z = 0
   bool translation_valid = false;
   int translation_source = 0;                       // as dsp::TranslationSource
@@ -62,6 +64,7 @@ struct SensorMotionRef {
   Eigen::Vector3d velocity_rotation_scale = Eigen::Vector3d::Ones();
   Eigen::Vector3d velocity_translation = Eigen::Vector3d::Zero();
   bool velocity_translation_valid = false;
+  Eigen::Vector3d velocity_translation_point = Eigen::Vector3d::Zero();
 };
 
 // A stick/slip decision to follow (kAuto only), taken from the fixed-point pipeline's
