@@ -1,0 +1,126 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+# tacse3 tools: the contact mask's centroid over a replay, and what the mask-change gate keeps of it.
+"""Reads a `tacse3-replay --dump-fields DIR` folder (standard library only, no NumPy) and prints,
+per pad: the sum of the mask centroid's per-frame steps (x, y in the pad's image axes, mm) over
+all frames in contact, the sum over the frames whose mask change 1 - |common| / |union| is at or
+below --gate (what the sliding translation rule kept with that `max_mask_change`), how many frames
+exceeded it, and, at the first and last frame in contact, the mask centroid, the number of cells
+of each connected component of the mask, the centroid of the largest component alone, the
+centroid weighted by the contact points' height z, and (with --recording, a simulator recording
+holding sim_labels.csv) the simulator's true patch centroid.
+
+Usage: mask_centroid.py DIR [--gate 0.3] [--recording REC_DIR]   (docs/dsp.md section 4.1)
+"""
+import argparse
+import csv
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from torsion_increments import CELLS, GRID_H, GRID_W, load_npy  # noqa: E402
+
+
+def components(cells):
+    """The 4-connected components of a set of grid indices (lists of indices), largest first."""
+    seen, found = set(), []
+    for start in cells:
+        if start in seen:
+            continue
+        seen.add(start)
+        stack, comp = [start], []
+        while stack:
+            k = stack.pop()
+            comp.append(k)
+            x, y = k % GRID_W, k // GRID_W
+            for nx, ny in ((x + 1, y), (x - 1, y), (x, y + 1), (x, y - 1)):
+                q = ny * GRID_W + nx
+                if 0 <= nx < GRID_W and 0 <= ny < GRID_H and q in cells and q not in seen:
+                    seen.add(q)
+                    stack.append(q)
+        found.append(comp)
+    return sorted(found, key=len, reverse=True)
+
+
+def sim_centroids(recording, pad):
+    path = os.path.join(recording, "sim_labels.csv")
+    out = {}
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            if row["sensor"] == pad:
+                out[int(row["index"])] = (float(row["centroid_u_mm"]), float(row["centroid_v_mm"]))
+    return out
+
+
+def pad_report(folder, pad, gate, recording):
+    mask, shape = load_npy(f"{folder}/{pad}/mask.npy")
+    points, _ = load_npy(f"{folder}/{pad}/points.npy")
+    frames = shape[0]
+    truth = sim_centroids(recording, pad) if recording else {}
+
+    def cells_of(n):
+        return {i for i in range(CELLS) if mask[n * CELLS + i]}
+
+    def centroid_mm(n, cells, weighted=False):
+        # weighted: by the contact point's height z (the indentation estimate from f^z)
+        w = [points[3 * (n * CELLS + i) + 2] if weighted else 1.0 for i in cells]
+        total = sum(w) or 1.0
+        sx = sum(wi * points[3 * (n * CELLS + i)] for wi, i in zip(w, cells))
+        sy = sum(wi * points[3 * (n * CELLS + i) + 1] for wi, i in zip(w, cells))
+        return sx / total * 1e3, sy / total * 1e3
+
+    all_steps, kept_steps = [0.0, 0.0], [0.0, 0.0]
+    over_gate = 0
+    prev, prev_c = None, None
+    first = last = None
+    for n in range(frames):
+        cells = cells_of(n)
+        if not cells:
+            prev = None
+            continue
+        c = centroid_mm(n, cells)
+        if first is None:
+            first = (n, cells, c)
+        last = (n, cells, c)
+        if prev:
+            change = 1.0 - len(cells & prev) / len(cells | prev)
+            for k in range(2):
+                all_steps[k] += c[k] - prev_c[k]
+                if change <= gate:
+                    kept_steps[k] += c[k] - prev_c[k]
+            if change > gate:
+                over_gate += 1
+        prev, prev_c = cells, c
+    if first is None:
+        print(f"{pad}: no frame in contact")
+        return
+    print(f"{pad}: centroid steps summed over all frames in contact: "
+          f"({all_steps[0]:.3f}, {all_steps[1]:.3f}) mm")
+    print(f"{pad}: summed over frames with mask change <= {gate}: "
+          f"({kept_steps[0]:.3f}, {kept_steps[1]:.3f}) mm; {over_gate} frame(s) above it")
+    for label, (n, cells, c) in (("first", first), ("last", last)):
+        comps = components(cells)
+        big = centroid_mm(n, comps[0])
+        zw = centroid_mm(n, cells, weighted=True)
+        line = (f"{pad}: {label} frame in contact {n}: mask centroid ({c[0]:.3f}, {c[1]:.3f}) mm, "
+                f"components {[len(k) for k in comps]}, largest component's centroid "
+                f"({big[0]:.3f}, {big[1]:.3f}) mm, z-weighted centroid ({zw[0]:.3f}, {zw[1]:.3f}) mm")
+        if n in truth:
+            line += f", simulator patch centroid ({truth[n][0]:.3f}, {truth[n][1]:.3f}) mm"
+        print(line)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("dir", help="tacse3-replay --dump-fields folder")
+    ap.add_argument("--gate", type=float, default=0.3, help="max_mask_change to evaluate")
+    ap.add_argument("--recording", help="the replayed simulator recording (for sim_labels.csv)")
+    a = ap.parse_args()
+    for pad in ("left", "right"):
+        if not os.path.exists(f"{a.dir}/{pad}/mask.npy"):
+            continue
+        pad_report(a.dir, pad, a.gate, a.recording)
+
+
+if __name__ == "__main__":
+    main()
