@@ -358,7 +358,10 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
           Eigen::Vector2d(static_cast<double>(common_dx), static_cast<double>(common_dy)) / nc *
           kNm;
     }
-    if (out.mask_change <= max_mask_change_) {
+    if (common == 0) {
+      // Ω_t and Ω_{t−1} share no cell: unrelated contacts (one vanished as another appeared),
+      // not a slide, which moves a patch by a fraction of its size per frame. No translation.
+    } else if (out.mask_change <= max_mask_change_) {
       if (weighted) {
         const double wt = static_cast<double>(m.sz), wp = static_cast<double>(prev_sz_);
         slide_disp.x() =
@@ -373,7 +376,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
             (static_cast<double>(m.sy) / nt - static_cast<double>(prev_sy_) / np) * kNm;
       }
       slide_source = TranslationSource::kCentroid;
-    } else if (common > 0) {
+    } else {
       slide_disp = common_disp;
       slide_source = TranslationSource::kCommonPoints;
     }

@@ -243,7 +243,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     Eigen::Vector3d slide = Eigen::Vector3d::Zero(), common_d = Eigen::Vector3d::Zero();
     int slide_source = 0;
     if (common > 0) common_d = sum_common / common;
-    if (change <= cal_.max_mask_change) {
+    if (common == 0) {
+      // No cell in both masks: unrelated contacts, no translation (dsp::MotionEstimator's rule).
+    } else if (change <= cal_.max_mask_change) {
       slide = weighted ? Eigen::Vector3d(zsum_now / z_now - zsum_prev / z_prev)
                        : Eigen::Vector3d(sum_now / out.points - sum_prev / prev_count);
       slide_source = 1;

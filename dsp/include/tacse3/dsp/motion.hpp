@@ -64,9 +64,10 @@ Eigen::Vector3d planar_content(const ContactMoments& m, double scale) noexcept;
 double content_alpha(double dt_s, double smoothing_s) noexcept;
 
 enum class TranslationSource : std::uint8_t {
-  kNone = 0,          // no translation this frame (no contact now or in the previous frame)
-  kCentroid = 1,      // displacement of the mask centroid (paper Sec. IV-D)
-  kCommonPoints = 2,  // mask changed too much: mean displacement of points in both masks
+  kNone = 0,      // no translation this frame (no contact now or before, or disjoint masks)
+  kCentroid = 1,  // displacement of the height-weighted mask centroid (paper Sec. IV-D, weighted)
+  kCommonPoints = 2,  // sticking, or mask changed beyond the gate: mean displacement of the
+                      // material points in both masks
 };
 
 // Per-sensor, per-frame result (sensor frame S).
@@ -80,7 +81,8 @@ struct SensorMotion {
   bool proxy_valid = false;  // false on the first displacement-mode frame after reset
   Eigen::Vector3d centroid_m = Eigen::Vector3d::Zero();  // 3D centroid of q over Ω (m)
   // The contact point whose velocity `translation` is (m): the height-weighted centroid
-  // Σ z q / Σ z for the sliding rule (kCentroid), centroid_m otherwise. The fusion refers the
+  // Σ z q / Σ z for the sliding rule (kCentroid; centroid_m when this or the previous frame has
+  // Σ z = 0), centroid_m otherwise. The fusion refers the
   // translation to G's origin from here (t = v − ω × point).
   Eigen::Vector3d translation_point_m = Eigen::Vector3d::Zero();
   // Contact-centroid velocity (m/s), t_z = 0, translation_scale applied.
@@ -124,17 +126,21 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 // detector's few scalars; no heap.
 //  - Translation (paper Sec. IV-D "contact-centroid planar translation"): c_t = centroid of the
 //    current positions over Ω_t, weighted by their height z (the indentation estimate, so the
-//    rim cells that flicker in and out of Ω hardly move it; the plain mean if Σ z = 0);
-//    t = (c_t − c_{t−1}) / Δt, t_z = 0. Spike rules:
+//    rim cells that flicker in and out of Ω hardly move it; the plain mean if Σ z = 0 in this
+//    or the previous frame); t = (c_t − c_{t−1}) / Δt, t_z = 0. Spike rules:
 //      * onset (Ω_{t−1} empty) or loss (Ω_t empty): t = 0, translation_valid = false;
-//      * kDisplacement proxy (the contact sticks): t is the mean displacement of the material
+//      * Ω_t ∩ Ω_{t−1} empty (unrelated contacts, not a slide): t = 0, translation_valid = false;
+//      * kDisplacement proxy, or kAuto while sticking: t is the mean displacement of the material
 //        points present in both masks — exact kinematics, and blind to Ω creeping backwards
 //        when a tangential load stretches the gel behind the patch (𝒢 reads that as expansion);
 //      * if 1 − |Ω_t ∩ Ω_{t−1}| / |Ω_t ∪ Ω_{t−1}| > max_mask_change (off by default), cells
 //        entering/leaving would move the centroid without any object motion, so t is the mean
 //        displacement of the material points present in both masks (exact while the contact
 //        sticks; zero in a slide, hence off by default);
-//      * otherwise the mask-centroid displacement (also follows a sliding patch).
+//      * otherwise the weighted centroid's displacement (also follows a sliding patch). With
+//        kVelocity this includes a centroid shift from pressing harder on a tilted object, or
+//        from pressure moving within the patch (rolling), which no rule here can tell from a
+//        slide; kAuto reads those, while the contact sticks, from the material points.
 //  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear over Ω; kDisplacement
 //    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt over Ω_t ∩ Ω_{t−1}, the previous shear
 //    kept per sensor.
