@@ -337,13 +337,12 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // there, and those the hysteresis keeps in Ω after the patch has moved on, hardly move it
   // (docs/accuracy.md item 5). Without any height (flat contact, height_gain 0) the plain mean.
   const bool weighted = m.sz > 0 && prev_sz_ > 0;
-  Eigen::Vector3d slide_point = out.centroid_m;
-  if (m.sz > 0) {
-    slide_point = Eigen::Vector3d(static_cast<double>(m.sxz), static_cast<double>(m.syz),
-                                  static_cast<double>(m.szz)) *
-                  kNm / static_cast<double>(m.sz);
-  }
-  if (!weighted) slide_point = out.centroid_m;
+  const Eigen::Vector3d slide_point =
+      weighted ? Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sxz),
+                                                 static_cast<double>(m.syz),
+                                                 static_cast<double>(m.szz)) *
+                                 kNm / static_cast<double>(m.sz))
+               : out.centroid_m;
   out.translation_point_m = out.centroid_m;
   const std::int64_t uni = m.n + prev_count_ - common;
   out.mask_change = uni > 0 ? 1.0 - static_cast<double>(common) / static_cast<double>(uni) : 1.0;

@@ -47,6 +47,18 @@ struct Runner {
   }
 };
 
+// Σ z q / Σ z over contact points: the sliding rule's height-weighted centroid.
+Eigen::Vector3d height_weighted_centroid(const std::vector<dsp_ref::PointSample>& points) {
+  Eigen::Vector3d zq = Eigen::Vector3d::Zero();
+  double zs = 0.0;
+  for (const auto& p : points) {
+    zq += p.q.z() * p.q;
+    zs += p.q.z();
+  }
+  EXPECT_GT(zs, 0.0);
+  return zq / zs;
+}
+
 void expect_finite(const SensorMotion& m) {
   EXPECT_TRUE(m.omega.allFinite());
   EXPECT_TRUE(m.translation.allFinite());
@@ -171,17 +183,10 @@ TEST(Motion, CentroidTranslationMatchesAnalyticMotion) {
     // the same in both frames).
     Eigen::Vector3d c = dsp_ref::centroid(f.points_G);
     if (mode == VelocityProxy::kVelocity) {
-      Eigen::Vector3d zq = Eigen::Vector3d::Zero();
-      double zs = 0.0;
-      for (const auto& p : f.points_G) {
-        zq += p.q.z() * p.q;
-        zs += p.q.z();
-      }
-      ASSERT_GT(zs, 0.0);
       // The weighting is visible at this test's bound: on the coarse grid the two centroids
       // differ, and ω × Δc moves the expected translation by more than the 3e-7 m/s tolerance.
       const Eigen::Vector3d plain = c;
-      c = zq / zs;
+      c = height_weighted_centroid(f.points_G);
       EXPECT_GT(sc.omega_G.cross(c - plain).head<2>().norm(), 6e-7);
     }
     Eigen::Vector3d expect = sc.omega_G.cross(c) + sc.t_G;
@@ -280,9 +285,7 @@ TEST(Motion, DisjointMasksGiveNoTranslation) {
     a.radius_m = b.radius_m = 3e-3;
     const SyntheticSensorFrames fa = dsp_ref::render_rigid_contact(cal, a);
     const SyntheticSensorFrames fb = dsp_ref::render_rigid_contact(cal, b);
-    VectorField still;
-    still.x.fill(0);
-    still.y.fill(0);
+    const VectorField still;  // zero-initialised: the gel does not move
     Runner run(cal);
     (void)run.frame(fa.fz, still, still);
     const SensorMotion m = run.frame(fb.fz, still, still);
@@ -477,8 +480,9 @@ TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
   // 10 mm slides (a third of the cells enter or leave in one frame): the patch stands still for
   // three frames, then jumps 1.5 mm. The gel does not move (w = 0: it slides). With the default
   // calibration the per-frame centroid differences telescope, so their sum is the centroid's
-  // whole displacement (9 mm; the centroid weighted by the points' height, the sliding rule's). With the old gate at 0.3 every jump frame read the material
-  // points (zero in a slide) and the motion was lost (docs/accuracy.md item 5).
+  // whole displacement (9 mm; the centroid weighted by the points' height, the sliding rule's).
+  // With the old gate at 0.3 every jump frame read the material points (zero in a slide) and
+  // the motion was lost (docs/accuracy.md item 5).
   for (bool gated : {false, true}) {
     Calibration cal;  // the default gate (off) unless `gated`
     cal.velocity_proxy = VelocityProxy::kVelocity;
@@ -492,29 +496,26 @@ TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
       sc.contact_centre_G = Eigen::Vector3d(-4.5e-3 + 1.5e-3 * (k / 4), 0.5e-3, 0.0);
       sc.radius_m = 3e-3;
       const SyntheticSensorFrames f = dsp_ref::render_rigid_contact(cal, sc);
-      VectorField still;
-      still.x.fill(0);
-      still.y.fill(0);
+      const VectorField still;  // zero-initialised: the gel does not move
       const SensorMotion m = run.frame(f.fz, still, still);
       ASSERT_TRUE(m.contact);
-      // The sliding rule's centroid: the mean of the contact points weighted by their height.
-      Eigen::Vector3d zq = Eigen::Vector3d::Zero();
-      double zs = 0.0;
+      // The sliding rule's centroid, from the contact points the detector built (nm → m).
+      std::vector<dsp_ref::PointSample> points;
       for (std::size_t i = 0; i < run.cs->mask.v.size(); ++i) {
         if (run.cs->mask.v[i] == 0) continue;
-        const double z = run.cs->z_nm.v[i];
-        zq += z * Eigen::Vector3d(run.cs->x_nm.v[i], run.cs->y_nm.v[i], 0.0) * 1e-9;
-        zs += z;
+        dsp_ref::PointSample p;
+        p.q = Eigen::Vector3d(run.cs->x_nm.v[i], run.cs->y_nm.v[i], run.cs->z_nm.v[i]) * 1e-9;
+        points.push_back(p);
       }
-      ASSERT_GT(zs, 0.0);
+      const Eigen::Vector3d c = height_weighted_centroid(points);
       if (k == 0) {
-        first = zq / zs;
+        first = c;
         continue;
       }
       ASSERT_TRUE(m.translation_valid) << k;
       if (m.mask_change > 0.3) ++jumps;
       sum += m.translation * kDt;
-      last = zq / zs;
+      last = c;
     }
     ASSERT_EQ(jumps, 6);  // every fourth frame
     const Eigen::Vector3d whole(last.x() - first.x(), last.y() - first.y(), 0.0);
@@ -551,9 +552,7 @@ TEST(Motion, SlidingCentroidIsWeightedByHeightSoAHysteresisTrailHardlyMovesIt) {
     }
   }
   ASSERT_GT(trail_cells, 30);
-  VectorField still;
-  still.x.fill(0);
-  still.y.fill(0);
+  const VectorField still;  // zero-initialised: the gel does not move
   Runner run(cal);
   const SensorMotion m0 = run.frame(f0.fz, still, still);
   const SensorMotion m1 = run.frame(trail, still, still);

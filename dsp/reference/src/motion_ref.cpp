@@ -249,7 +249,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       slide = weighted ? Eigen::Vector3d(zsum_now / z_now - zsum_prev / z_prev)
                        : Eigen::Vector3d(sum_now / out.points - sum_prev / prev_count);
       slide_source = 1;
-    } else if (common > 0) {
+    } else {
       slide = common_d;
       slide_source = 2;
     }
