@@ -110,11 +110,30 @@ void fuse_joint(const std::array<const SensorMotion*, 2>& s, const FusionConfig&
     opt.lambda_abs = n_total * cfg.solve_lever_floor_m * cfg.solve_lever_floor_m;
     opt.rcond_min = cfg.solve_rcond_min;
     const Solve3Result r = solve3(AtA, Atb, opt);
-    omega = (scale / nw) * r.x;
-    if (!omega.allFinite()) omega.setZero();
-    out.rotation_valid = r.valid;
     out.confidence = r.rcond;
-    out.rank = r.rank;
+    if (nw == 2) {
+      omega = (scale / nw) * r.x;
+      out.rotation_valid = r.valid;
+      out.rank = r.rank;
+    } else {
+      // One pad: only the rotation about its normal n. A rotation about an in-plane axis shears
+      // a flat pad like a translation does; the 3x3 solve would read those two components from
+      // the sub-millimetre lever of the indentation's heights alone, where a few µm of shear
+      // noise per frame become rad/s (a pad dropping out for a few frames of a dual grasp turned
+      // a 4° torsion into 16.8°). They are reported as 0: the 1-D least squares along n,
+      // ω = n (nᵀAᵀb)/(nᵀAᵀA n + λ), with the λ of the 3x3 solve. rank = 1 says so.
+      const int i = (out.rotation_sensors & kSensor1) != 0 ? 0 : 1;
+      const Eigen::Vector3d n = cfg.extrinsics[static_cast<std::size_t>(i)].R_GS.col(2);
+      const double lambda = opt.lambda_rel * AtA.trace() / 3.0 + opt.lambda_abs;
+      const double lever = n.dot(AtA * n);  // Σ of the squared levers about n
+      const double num = n.dot(Atb);
+      const bool solvable = lever > 0.0 && std::isfinite(lever + lambda) && std::isfinite(num);
+      const double den = lever + lambda;
+      omega = solvable ? Eigen::Vector3d(scale * n * (num / den)) : Eigen::Vector3d::Zero();
+      out.rotation_valid = solvable;
+      out.rank = solvable ? 1 : 0;
+    }
+    if (!omega.allFinite()) omega.setZero();
     out.xi.head<3>() = omega;
   }
 

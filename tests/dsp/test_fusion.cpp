@@ -236,6 +236,38 @@ TEST(Fusion, SingleSensorWorksForBothMethodsAndIsFlagged) {
   EXPECT_EQ(Eigen::Vector3d(p1.xi.tail<3>()), d.left.translation);
 }
 
+// One pad alone: the joint fusion reads only the rotation about that pad's normal. A rotation
+// about an in-plane axis shears one flat pad like a translation; the noise-free scene here would
+// still let the 3x3 solve recover it from the indentation's heights, but on real frames those
+// sub-millimetre levers turn shear noise into rad/s (docs/dsp.md §7b), so the two in-plane
+// components are reported as exactly 0, rank 1, and the translation stays referred correctly.
+TEST(FusionJoint, OnePadReadsOnlyTheRotationAboutItsNormal) {
+  const Eigen::Vector3d w(0.4, -0.3, 0.5), t(3e-3, -1e-3, 0.0);
+  const Dual d = observe(w, t);
+  const Dual in_plane = observe(Eigen::Vector3d(0.4, -0.3, 0.0), kZero);
+  for (int which = 0; which < 2; ++which) {
+    const SensorMotion* pad = which == 0 ? &d.left : &d.right;
+    const FusedMotion f = which == 0 ? fuse_with(FusionMethod::kJoint, pad, nullptr)
+                                     : fuse_with(FusionMethod::kJoint, nullptr, pad);
+    EXPECT_TRUE(f.single_sensor);
+    EXPECT_TRUE(f.rotation_valid);
+    EXPECT_EQ(f.rank, 1);
+    EXPECT_EQ(f.xi(0), 0.0) << which;
+    EXPECT_EQ(f.xi(1), 0.0) << which;
+    EXPECT_NEAR(f.xi(2), 0.5, 1e-3) << which;
+    // Both pads: all three components.
+    const FusedMotion both = fuse_with(FusionMethod::kJoint, &d.left, &d.right);
+    EXPECT_LT((both.xi.head<3>() - w).norm(), 2e-4 * w.norm());
+    // An in-plane rotation alone: nothing about the normal, nothing read in the plane.
+    const SensorMotion* ip = which == 0 ? &in_plane.left : &in_plane.right;
+    const FusedMotion g = which == 0 ? fuse_with(FusionMethod::kJoint, ip, nullptr)
+                                     : fuse_with(FusionMethod::kJoint, nullptr, ip);
+    EXPECT_EQ(g.xi(0), 0.0);
+    EXPECT_EQ(g.xi(1), 0.0);
+    EXPECT_LT(std::abs(g.xi(2)), 1e-3);
+  }
+}
+
 TEST(Fusion, NoContactGivesZeroInvalid) {
   const SensorMotion none;
   for (FusionMethod m : {FusionMethod::kPaper, FusionMethod::kJoint}) {

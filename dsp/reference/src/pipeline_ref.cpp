@@ -148,6 +148,7 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
       // centroid of all points (dsp/fusion.cpp), λ as in solve3.
       std::vector<PointSample> all;
       Eigen::Matrix3d scale = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // of the last contributing pad, in G
       int nw = 0;
       for (int i = 0; i < 2; ++i) {
         const auto& s = m[static_cast<std::size_t>(i)];
@@ -163,6 +164,7 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
         }
         const Eigen::Vector3d& rs = velocity ? s.velocity_rotation_scale : s.rotation_scale;
         scale += e.R_GS * rs.asDiagonal() * e.R_GS.transpose();
+        normal = e.R_GS * Eigen::Vector3d::UnitZ();
         ++nw;
       }
       if (!all.empty()) {
@@ -171,8 +173,16 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
         const double n = static_cast<double>(all.size());
         const double lambda = fc.solve_lambda_rel * sys.A.squaredNorm() / 3.0 +
                               n * fc.solve_lever_floor_m * fc.solve_lever_floor_m;
-        omega = (scale / nw) * solve_stacked(sys, lambda);
-        rotation_valid = true;
+        if (nw == 2) {
+          omega = (scale / nw) * solve_stacked(sys, lambda);
+          rotation_valid = true;
+        } else {
+          // One pad: ω along its normal only, ω = n argmin_s ‖A n s − b‖² + λ s² (dsp/fusion.cpp).
+          const Eigen::VectorXd column = sys.A * normal;
+          const double lever = column.squaredNorm();
+          if (lever > 0.0) omega = scale * normal * (column.dot(sys.b) / (lever + lambda));
+          rotation_valid = lever > 0.0;
+        }
       }
       Eigen::Vector3d v_mean = Eigen::Vector3d::Zero();
       Eigen::Vector3d c_mean = Eigen::Vector3d::Zero();
