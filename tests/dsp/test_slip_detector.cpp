@@ -272,6 +272,29 @@ TEST(SlipDetector, StickRampAndHoldStaysStuckAndEqualsTheDisplacementProxy) {
   EXPECT_NEAR(integrate_z(t.omega_ref), 4.0 * kDeg, 0.02 * kDeg);
 }
 
+// A stuck contact whose Ω loses its rim for a while (on small or deeply pressed objects the rim
+// cells flicker out of Ω, and during the grasp Ω can collapse for a few frames). The rigid
+// content X over Ω then drops by a third although no cell's shear changed; read as a relaxation
+// it started a slip, and the velocity proxy then integrated the held shear (a 3° torsion read as
+// 26-30° on the simulator). The detector reads dX from the increments over Ω_t ∩ Ω_{t−1}.
+TEST(SlipDetector, AStuckContactLosingItsRimStaysStuck) {
+  std::vector<double> theta;
+  for (int k = 0; k < 24; ++k) theta.push_back(0.0);
+  for (int k = 0; k <= 60; ++k) theta.push_back(4.0 * kDeg * min_jerk(k / 60.0));
+  for (int k = 0; k < 120; ++k) theta.push_back(4.0 * kDeg);
+  const Trace t = run(theta, VelocityProxy::kDisplacement, [](std::size_t k) -> const Disc* {
+    static const Disc wide(6.0), narrow(4.0);
+    return k >= 24 + 60 + 20 && k < 24 + 60 + 40 ? &narrow : &wide;
+  });
+  EXPECT_EQ(t.onsets, 0);
+  for (std::size_t k = 0; k < theta.size(); ++k) {
+    ASSERT_FALSE(t.slipping[k]) << "frame " << k;
+    ASSERT_FALSE(t.slipping_ref[k]) << "frame " << k;
+  }
+  EXPECT_NEAR(integrate_z(t.omega_auto), 4.0 * kDeg, 0.02 * kDeg);
+  EXPECT_NEAR(integrate_z(t.omega_ref), 4.0 * kDeg, 0.02 * kDeg);
+}
+
 TEST(SlipDetector, SlideIsDetectedWhenTheShearRelaxesAndThePoseCatchesUp) {
   // A slide: the shear follows the sliding speed (gel lag ignored), rising and falling with a
   // minimum-jerk speed profile of a 30° rotation over 1 s, then 0.5 s at rest. The velocity

@@ -78,6 +78,7 @@ void MotionRef::reset_detector() {
   rest_s_ = 0.0;
   peak_shift_m_ = 0.0;
   content_.setZero();
+  change_.setZero();
   have_content_ = false;
 }
 
@@ -162,26 +163,33 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     if (out.points == 0) {
       reset_detector();
     } else {
-      // Planar rigid-body content of the shear read as a contact displacement (brute force).
-      const double np = static_cast<double>(out.points);
-      const Eigen::Vector3d cen = sum_now / np;
-      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-      double torque = 0.0, inertia = 0.0;
-      for (const auto& p : shear_pts) {
-        const Eigen::Vector2d r = (p.q - cen).head<2>();
-        const Eigen::Vector2d v = cal_.c_displacement * p.v.head<2>();
-        mean += v;
-        torque += r.x() * v.y() - r.y() * v.x();
-        inertia += r.squaredNorm();
-      }
-      mean /= np;
-      const Eigen::Vector3d raw(inertia > 0.0 ? torque / std::sqrt(np * inertia) : 0.0, mean.x(),
-                                mean.y());
-      const Eigen::Vector3d before = content_;
+      // Planar rigid-body content of the shear read as a contact displacement (brute force):
+      // X over Ω, its change over Ω_t ∩ Ω_{t−1} (the increments), both smoothed.
+      auto planar = [&](const std::vector<PointSample>& pts) -> Eigen::Vector3d {
+        if (pts.empty()) return Eigen::Vector3d::Zero();
+        const double k = static_cast<double>(pts.size());
+        Eigen::Vector3d cen = Eigen::Vector3d::Zero();
+        for (const auto& p : pts) cen += p.q;
+        cen /= k;
+        Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+        double torque = 0.0, inertia = 0.0;
+        for (const auto& p : pts) {
+          const Eigen::Vector2d r = (p.q - cen).head<2>();
+          const Eigen::Vector2d v = cal_.c_displacement * p.v.head<2>();
+          mean += v;
+          torque += r.x() * v.y() - r.y() * v.x();
+          inertia += r.squaredNorm();
+        }
+        mean /= k;
+        return {inertia > 0.0 ? torque / std::sqrt(k * inertia) : 0.0, mean.x(), mean.y()};
+      };
+      const Eigen::Vector3d raw = planar(shear_pts);
+      const Eigen::Vector3d step = planar(incr_pts);
       const double alpha = cal_.slip_smoothing_s > 0.0 ? dt / (cal_.slip_smoothing_s + dt) : 1.0;
       content_ = have_content_ ? Eigen::Vector3d(content_ + alpha * (raw - content_)) : raw;
-      const Eigen::Vector3d change =
-          have_content_ ? Eigen::Vector3d(content_ - before) : Eigen::Vector3d::Zero();
+      change_ = have_content_ ? Eigen::Vector3d(change_ + alpha * (step - change_))
+                              : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d& change = change_;
       have_content_ = true;
       const double x2 = content_.squaredNorm();
       out.shear_shift_m = std::sqrt(x2);

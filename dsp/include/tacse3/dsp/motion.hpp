@@ -201,6 +201,7 @@ class MotionEstimator {
   double peak_shift_m_ = 0.0;
   double smoothing_s_ = 0.0;
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();  // smoothed X
+  Eigen::Vector3d change_ = Eigen::Vector3d::Zero();   // smoothed dX (over Ω_t ∩ Ω_{t−1})
   bool have_content_ = false;
   void reset_detector() noexcept;
 };

@@ -103,6 +103,7 @@ class MotionRef {
   double rest_s_ = 0.0;
   double peak_shift_m_ = 0.0;
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d change_ = Eigen::Vector3d::Zero();
   bool have_content_ = false;
   void reset_detector();
 };
