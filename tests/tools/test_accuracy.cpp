@@ -163,4 +163,46 @@ TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
   EXPECT_LT(apart, 0.3);
 }
 
+// Stick grasps on the objects where the detector used to call a slip: a small sphere, a sphere
+// pressed 1.5 mm deep, the fluted screwdriver handle. There Ω's rim flickers (or collapses for a
+// few frames of the grasp), and the rigid content of the shear over Ω dropped with no slide; the
+// velocity proxy then integrated the held shear (26-34 deg for 2-3 deg, docs/accuracy.md). With the
+// committed calibration and the default --mode auto, as a user would replay them.
+TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
+  tacse3::config::CalibrationSet cal;
+  const tacse3::config::Status st = tacse3::config::load_calibration(TACSE3_SIM_CALIBRATION, &cal);
+  ASSERT_TRUE(st.ok()) << st.message();
+  auto stick = [](const char* object, const char* motion, double deg, std::uint64_t seed,
+                  double radius, double indentation) {
+    tt::SimCase c;
+    c.object = object;
+    c.motion = motion;
+    c.magnitude = deg;
+    c.seed = seed;
+    c.radius_mm = radius;
+    c.indentation_mm = indentation;
+    return c;
+  };
+  const std::vector<tt::SimCase> cases = {stick("sphere", "rz", 3, 3, 15, 1.0),
+                                          stick("sphere", "ry", 2, 3, 12, 1.0),
+                                          stick("sphere", "rz", 3, 4, 0, 1.5),
+                                          stick("screwdriver", "rx", 2, 2, 0, 1.0)};
+  const std::vector<tt::EvalConfig> cfg = {
+      {tacse3::dsp::FusionMethod::kJoint, tt::ProxyMode::kAuto, tt::SensorChoice::kBoth, false}};
+  for (const tt::SimCase& c : cases) {
+    std::vector<tt::EvalResult> res;
+    const std::string err = tt::evaluate_case(c, cal, cfg, &res);
+    ASSERT_TRUE(err.empty()) << err;
+    const auto& e = res[0].errors;
+    const tt::SlipScore& sl = res[0].slip;
+    std::printf("%-40s rotation error %.2f deg (estimated %.2f), %lld sensor-frames called "
+                "slipping\n",
+                c.sim_arguments().c_str(), e.final_rotation_error_deg, e.estimated_rotation_deg,
+                static_cast<long long>(sl.false_slip + sl.true_slip));
+    ASSERT_TRUE(res[0].slip_scored);
+    EXPECT_EQ(sl.false_slip + sl.true_slip, 0) << c.sim_arguments();
+    EXPECT_LT(e.final_rotation_error_deg, 1.0) << c.sim_arguments();
+  }
+}
+
 }  // namespace
