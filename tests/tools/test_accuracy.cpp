@@ -15,14 +15,23 @@ namespace {
 
 namespace tt = tacse3::tools;
 
-tt::SimCase short_case(const char* object, const char* motion, double magnitude, std::uint64_t seed,
-                       double radius) {
+// A simulated grasp with tacse3-sim's default timeline (radius 0 = the preset's size).
+tt::SimCase sim_case(const char* object, const char* motion, double magnitude, std::uint64_t seed,
+                     double radius, double indentation = 1.0) {
   tt::SimCase c;
   c.object = object;
   c.motion = motion;
   c.magnitude = magnitude;
   c.seed = seed;
   c.radius_mm = radius;
+  c.indentation_mm = indentation;
+  return c;
+}
+
+// The same with a shorter timeline, for the calibrate-and-evaluate regression.
+tt::SimCase short_case(const char* object, const char* motion, double magnitude, std::uint64_t seed,
+                       double radius) {
+  tt::SimCase c = sim_case(object, motion, magnitude, seed, radius);
   c.approach_s = 0.05;
   c.grasp_s = 0.25;
   c.settle_s = 0.05;
@@ -121,10 +130,8 @@ TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
   tacse3::config::CalibrationSet cal;
   const tacse3::config::Status st = tacse3::config::load_calibration(TACSE3_SIM_CALIBRATION, &cal);
   ASSERT_TRUE(st.ok()) << st.message();
-  tt::SimCase c;  // a stick torsion of a small sphere (small contacts, short levers)
-  c.motion = "rz";
-  c.magnitude = 4.0;
-  c.radius_mm = 15.0;
+  // A stick torsion of a small sphere (small contacts, short levers).
+  const tt::SimCase c = sim_case("sphere", "rz", 4.0, 1, 15.0);
   tacse3::sim::SimConfig sc;
   ASSERT_EQ(tt::make_sim_config(c, &sc), "");
   std::string err;
@@ -172,21 +179,10 @@ TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
   tacse3::config::CalibrationSet cal;
   const tacse3::config::Status st = tacse3::config::load_calibration(TACSE3_SIM_CALIBRATION, &cal);
   ASSERT_TRUE(st.ok()) << st.message();
-  auto stick = [](const char* object, const char* motion, double deg, std::uint64_t seed,
-                  double radius, double indentation) {
-    tt::SimCase c;
-    c.object = object;
-    c.motion = motion;
-    c.magnitude = deg;
-    c.seed = seed;
-    c.radius_mm = radius;
-    c.indentation_mm = indentation;
-    return c;
-  };
-  const std::vector<tt::SimCase> cases = {stick("sphere", "rz", 3, 3, 15, 1.0),
-                                          stick("sphere", "ry", 2, 3, 12, 1.0),
-                                          stick("sphere", "rz", 3, 4, 0, 1.5),
-                                          stick("screwdriver", "rx", 2, 2, 0, 1.0)};
+  const std::vector<tt::SimCase> cases = {sim_case("sphere", "rz", 3, 3, 15),
+                                          sim_case("sphere", "ry", 2, 3, 12),
+                                          sim_case("sphere", "rz", 3, 4, 0, 1.5),
+                                          sim_case("screwdriver", "rx", 2, 2, 0)};
   const std::vector<tt::EvalConfig> cfg = {
       {tacse3::dsp::FusionMethod::kJoint, tt::ProxyMode::kAuto, tt::SensorChoice::kBoth, false}};
   for (const tt::SimCase& c : cases) {
