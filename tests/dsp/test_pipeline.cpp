@@ -175,6 +175,13 @@ TEST_P(FixedVsReference, TwistAndFinalPoseAgree) {
               b.z() / kDeg, omega_snr_db(ref.twist, fx.twist),
               rms_omega_difference(ref.twist, fx.twist), (fx.pose.p - ref.pose.p).norm());
   EXPECT_LT((a - b).norm() / kDeg, 0.1 + 0.01 * b.norm() / kDeg);
+  if (c.left_only && c.method == FusionMethod::kJoint) {
+    // One pad: both read only the rotation about the pad normal (dsp/fusion.cpp).
+    EXPECT_EQ(a.x(), 0.0);
+    EXPECT_EQ(a.y(), 0.0);
+    EXPECT_EQ(b.x(), 0.0);
+    EXPECT_EQ(b.y(), 0.0);
+  }
   EXPECT_LT((fx.pose.p - ref.pose.p).norm(), 100e-6);
   if (b.norm() / kDeg > 0.5) {
     EXPECT_GT(omega_snr_db(ref.twist, fx.twist), 30.0);
@@ -195,7 +202,9 @@ INSTANTIATE_TEST_SUITE_P(
         AgreementCase{"ty0.4_paper_displacement", translation_along_y, FusionMethod::kPaper,
                       VelocityProxy::kDisplacement},
         AgreementCase{"rz3_joint_displacement_left_only", rotation_about_z, FusionMethod::kJoint,
-                      VelocityProxy::kDisplacement, true}),
+                      VelocityProxy::kDisplacement, true},
+        AgreementCase{"rx1.5_joint_velocity_left_only", rotation_about_x, FusionMethod::kJoint,
+                      VelocityProxy::kVelocity, true}),
     [](const ::testing::TestParamInfo<AgreementCase>& i) {
       std::string n = i.param.name;
       for (char& ch : n) {

@@ -275,8 +275,9 @@ TEST(SlipDetector, StickRampAndHoldStaysStuckAndEqualsTheDisplacementProxy) {
 // A stuck contact whose Ω loses its rim for a while (on small or deeply pressed objects the rim
 // cells flicker out of Ω, and during the grasp Ω can collapse for a few frames). The rigid
 // content X over Ω then drops by a third although no cell's shear changed; read as a relaxation
-// it started a slip, and the velocity proxy then integrated the held shear (a 3° torsion read as
-// 26-30° on the simulator). The detector reads dX from the increments over Ω_t ∩ Ω_{t−1}.
+// it started a slip, and the velocity proxy then integrated the held shear (2-3° stick motions
+// read as 19-34° on the simulator, docs/accuracy.md item 8). The detector reads dX from the
+// increments over Ω_t ∩ Ω_{t−1}.
 TEST(SlipDetector, AStuckContactLosingItsRimStaysStuck) {
   std::vector<double> theta;
   for (int k = 0; k < 24; ++k) theta.push_back(0.0);

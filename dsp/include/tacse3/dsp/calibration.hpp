@@ -75,7 +75,8 @@ struct Calibration {
   // the planar rigid-body content of the shear field over Ω read as a contact displacement
   // (c_displacement scaling): X = [L·θ, t_x, t_y], the rotation θ about the pad normal times the
   // contact's rms lever L and the mean shift t (motion.hpp planar_content), smoothed
-  // exponentially with time constant slip_smoothing_s; dX is the smoothed X's change per frame.
+  // exponentially with time constant slip_smoothing_s; dX is its change per frame, read from the
+  // shear increments over the cells in both masks, Ω_t ∩ Ω_{t−1}, and smoothed alike.
   // Slip onset: the shear relaxes while loaded, ρ = −X·dX / (|X|² Δt) > slip_relax_rate_on for
   // slip_on_frames consecutive frames with |X| > slip_min_shift_m. A sticking contact's shear is
   // the accumulated contact displacement and only shrinks if the object moves back; a sliding

@@ -69,8 +69,12 @@ struct FusedMotion {
   bool rotation_valid = false;
   bool translation_valid = false;
   bool valid = false;       // rotation_valid && translation_valid
-  double confidence = 0.0;  // rcond of the solve(s) behind ω (min over sensors for kPaper)
-  int rank = 0;             // observed ω directions (min over sensors for kPaper)
+  // rcond of the 3x3 normal equations (min over sensors for kPaper). kJoint with one pad: still
+  // the 3x3 system's, although ω then comes from the 1-D solve about the pad normal.
+  double confidence = 0.0;
+  // Observed ω directions (min over sensors for kPaper); kJoint with one pad: 1 (0 when the pad's
+  // points have no lever about its normal, then ω = 0 and rotation_valid is false).
+  int rank = 0;
   // kJoint: the point (in G) whose velocity the averaged centroid translation measured; t was
   // referred from it to G's origin (t = t̄ − ω × m̄). kPaper: unused (zero).
   Eigen::Vector3d reference_point = Eigen::Vector3d::Zero();
