@@ -124,11 +124,10 @@ void fuse_joint(const std::array<const SensorMotion*, 2>& s, const FusionConfig&
       // ω = n (nᵀAᵀb)/(nᵀAᵀA n + λ), with the λ of the 3x3 solve. rank = 1 says so.
       const int i = (out.rotation_sensors & kSensor1) != 0 ? 0 : 1;
       const Eigen::Vector3d n = cfg.extrinsics[static_cast<std::size_t>(i)].R_GS.col(2);
-      const double lambda = opt.lambda_rel * AtA.trace() / 3.0 + opt.lambda_abs;
       const double lever = n.dot(AtA * n);  // Σ of the squared levers about n
       const double num = n.dot(Atb);
-      const bool solvable = lever > 0.0 && std::isfinite(lever + lambda) && std::isfinite(num);
-      const double den = lever + lambda;
+      const double den = lever + r.lambda;
+      const bool solvable = lever > 0.0 && std::isfinite(den) && std::isfinite(num);
       omega = solvable ? Eigen::Vector3d(scale * n * (num / den)) : Eigen::Vector3d::Zero();
       out.rotation_valid = solvable;
       out.rank = solvable ? 1 : 0;

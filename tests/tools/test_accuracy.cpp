@@ -15,6 +15,14 @@ namespace {
 
 namespace tt = tacse3::tools;
 
+// The simulator calibration committed beside tacse3-replay (what a user replays with).
+tacse3::config::CalibrationSet committed_calibration() {
+  tacse3::config::CalibrationSet cal;
+  const tacse3::config::Status st = tacse3::config::load_calibration(TACSE3_SIM_CALIBRATION, &cal);
+  EXPECT_TRUE(st.ok()) << st.message();
+  return cal;
+}
+
 // A simulated grasp with tacse3-sim's default timeline (radius 0 = the preset's size).
 tt::SimCase sim_case(const char* object, const char* motion, double magnitude, std::uint64_t seed,
                      double radius, double indentation = 1.0) {
@@ -127,9 +135,8 @@ TEST(Accuracy, CalibratedPipelineTracksShortSimulatedGrasps) {
 // in-plane components would rest on the indentation's sub-millimetre heights alone, where the
 // shear noise of a pad at rest became rad/s and turned the object by degrees per dropout.
 TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
-  tacse3::config::CalibrationSet cal;
-  const tacse3::config::Status st = tacse3::config::load_calibration(TACSE3_SIM_CALIBRATION, &cal);
-  ASSERT_TRUE(st.ok()) << st.message();
+  const tacse3::config::CalibrationSet cal = committed_calibration();
+  ASSERT_FALSE(::testing::Test::HasFailure());
   // A stick torsion of a small sphere (small contacts, short levers).
   const tt::SimCase c = sim_case("sphere", "rz", 4.0, 1, 15.0);
   tacse3::sim::SimConfig sc;
@@ -176,9 +183,8 @@ TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
 // velocity proxy then integrated the held shear (21-34 deg for 2-3 deg, docs/accuracy.md). With the
 // committed calibration and the default --mode auto, as a user would replay them.
 TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
-  tacse3::config::CalibrationSet cal;
-  const tacse3::config::Status st = tacse3::config::load_calibration(TACSE3_SIM_CALIBRATION, &cal);
-  ASSERT_TRUE(st.ok()) << st.message();
+  const tacse3::config::CalibrationSet cal = committed_calibration();
+  ASSERT_FALSE(::testing::Test::HasFailure());
   const std::vector<tt::SimCase> cases = {sim_case("sphere", "rz", 3, 3, 15),
                                           sim_case("sphere", "ry", 2, 3, 12),
                                           sim_case("sphere", "rz", 3, 4, 0, 1.5),
