@@ -326,8 +326,10 @@ inline TemplateSums template_sums(const FlowWindowTemplate& tpl, const std::int1
 
 // Neighbour consensus (a PIV-style outlier test) on one grid level: a tracked point (ok = 1) is
 // rejected when fewer than half of its tracked 8-neighbours agree with it within `tol` (Q16, per
-// axis), or when it has no tracked neighbour at all (a lone match in a failed region is more
-// likely wrong than right). Decisions use the flags as they were on entry.
+// axis), or when fewer than two agree at all: a lone match, or a pair of matches that only agree
+// with each other, in a failed region is more likely wrong than right (such a pair, 10 px off,
+// survived a cold 16 px jump once max_residual_ratio was 0.30). Decisions use the flags as they
+// were on entry.
 void reject_outliers(int gw, int gh, const std::int32_t* fx, const std::int32_t* fy,
                      std::uint8_t* ok, std::int32_t tol, std::uint8_t* scratch) noexcept {
   std::copy_n(ok, gw * gh, scratch);
@@ -338,7 +340,7 @@ void reject_outliers(int gw, int gh, const std::int32_t* fx, const std::int32_t*
            2u * static_cast<std::uint64_t>(tol);
   };
   const auto decide = [&](int i, int tracked, int agree) {
-    if (tracked == 0 || 2 * agree < tracked) ok[i] = 0;
+    if (agree < 2 || 2 * agree < tracked) ok[i] = 0;
   };
   const int offsets[8] = {-gw - 1, -gw, -gw + 1, -1, 1, gw - 1, gw, gw + 1};
   for (int y = 0; y < gh; ++y) {

@@ -372,6 +372,25 @@ TEST(BlockFlow, EmptyAndSaturatedFramesAreFlaggedAndHeld) {
   EXPECT_LE(error_against(w, d, v).rms, 0.05);
 }
 
+// The other side of max_residual_ratio: a frame of a different random-dot pattern (a swapped
+// sensor, a wrong tare) must not be "tracked". The bound was raised from 0.15 to 0.30 so that
+// strained, shaded gel under contact stays tracked (tools_test_accuracy
+// TheFlowTracksThePressedGelEverywhere); an unrelated window leaves ~1 of its template energy, and
+// the rare chance match below 0.30 has no two neighbours agreeing with it (neighbour consensus).
+TEST(BlockFlow, AnUnrelatedPatternIsNotTracked) {
+  auto f = make_flow();
+  for (const std::uint64_t seed : {7u, 8u, 9u}) {
+    const test::DotTexture other(seed);
+    f->tare(undeformed());
+    VectorField d;
+    GridMask v;
+    f->track(test::render_work_image(other, Warp::identity()), d, v);
+    std::printf("  pattern seed %d against the tare of seed 42: %d of %d points called tracked\n",
+                static_cast<int>(seed), f->valid_count(), kGridCount);
+    EXPECT_LE(f->valid_count(), kGridCount / 100) << "seed " << seed;
+  }
+}
+
 TEST(BlockFlow, BlankReferenceHasNoTrackablePoints) {
   auto f = make_flow();
   const auto bytes = test::constant_frame(0, PixelFormat::kGrey);

@@ -2,10 +2,14 @@
 // tacse3 tests: reduced accuracy regression: calibrate on short simulated grasps, evaluate others.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "tacse3/config/calibration_file.hpp"
+#include "tacse3/dsp/block_flow.hpp"
+#include "tacse3/dsp/luma.hpp"
 #include "tacse3/tools/bench.hpp"
 #include "tacse3/tools/metrics.hpp"
 #include "tacse3/tools/replay.hpp"
@@ -207,6 +211,55 @@ TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
     EXPECT_LE(sl.false_slip + sl.true_slip, 6) << c.sim_arguments();
     EXPECT_LT(e.final_rotation_error_deg, 1.0) << c.sim_arguments();
   }
+}
+
+
+// The block flow on the simulator's pressed, shaded, noisy gel: the pattern at the patch is
+// strained (the bulge, the shear) and shaded, so a correct match leaves more residual than on a
+// shifted frame. With the old residual bound (0.15 of the template energy) 12 % of the grid was
+// untracked at rest after the grasp and 17 % at the torsion's peak, all around and inside the
+// patch; the smoothed field, 𝒢 and the mask then leaned away from them (docs/accuracy.md item 9).
+TEST(Accuracy, TheFlowTracksThePressedGelEverywhere) {
+  const tt::SimCase c = sim_case("sphere", "rz", 30, 1, 0);
+  tacse3::sim::SimConfig sc;
+  ASSERT_EQ(tt::make_sim_config(c, &sc), "");
+  std::string err;
+  auto src = tt::SimSource::create(sc, c.label(), 1, &err);
+  ASSERT_TRUE(src) << err;
+  const tt::SourceInfo& info = src->info();
+  // The default flow, and beside it one with the old bound for the record (printed only).
+  tacse3::dsp::BlockFlowConfig old_bound;
+  old_bound.max_residual_ratio = 0.15;
+  std::array<std::unique_ptr<tacse3::dsp::BlockFlow>, 2> flows{
+      std::make_unique<tacse3::dsp::BlockFlow>(),  // ~1 MB each: on the heap in a test
+      std::make_unique<tacse3::dsp::BlockFlow>(old_bound)};
+  tacse3::dsp::WorkImage img;
+  tacse3::dsp::VectorField d;
+  tacse3::dsp::GridMask v;
+  // Default timeline: the grasp ends at 0.5 s, the motion runs 0.6-1.6 s.
+  std::array<int, 2> worst_rest{}, worst_motion{};
+  for (std::size_t i = 0; i < info.frame_count(); ++i) {
+    std::array<const tacse3::dsp::FrameView*, 2> views{};
+    ASSERT_EQ(src->read(i, &views), "");
+    ASSERT_NE(views[0], nullptr);
+    ASSERT_EQ(tacse3::dsp::frame_to_work_image(*views[0], img), tacse3::dsp::Status::kOk);
+    const double t = static_cast<double>(info.t_ns[i] - info.t_ns[0]) * 1e-9;
+    for (std::size_t k = 0; k < flows.size(); ++k) {
+      flows[k]->track(img, d, v);
+      const int untracked = tacse3::dsp::kGridCount - flows[k]->valid_count();
+      if (t >= 0.5 && t < 0.6) worst_rest[k] = std::max(worst_rest[k], untracked);
+      if (t >= 0.6 && t < 1.6) worst_motion[k] = std::max(worst_motion[k], untracked);
+    }
+  }
+  for (std::size_t k = 0; k < flows.size(); ++k) {
+    std::printf("sphere rz 30, left pad, max_residual_ratio %.2f: at most %d of %d flow points "
+                "untracked at rest after the grasp, %d during the torsion\n",
+                flows[k]->config().max_residual_ratio, worst_rest[k], tacse3::dsp::kGridCount,
+                worst_motion[k]);
+  }
+  EXPECT_EQ(flows[0]->config().max_residual_ratio, tacse3::dsp::BlockFlowConfig{}.max_residual_ratio);
+  EXPECT_LE(worst_rest[0], tacse3::dsp::kGridCount / 100);
+  EXPECT_LE(worst_motion[0], tacse3::dsp::kGridCount * 3 / 100);
 }
 
 }  // namespace

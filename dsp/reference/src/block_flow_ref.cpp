@@ -62,7 +62,7 @@ void reject_outliers_ref(int gw, int gh, const std::vector<double>& fx,
           if (std::abs(fx[j] - fx[i]) <= tol && std::abs(fy[j] - fy[i]) <= tol) ++agree;
         }
       }
-      if (tracked == 0 || 2 * agree < tracked) ok[i] = 0;
+      if (agree < 2 || 2 * agree < tracked) ok[i] = 0;
     }
   }
 }
