@@ -376,7 +376,8 @@ TEST(BlockFlow, EmptyAndSaturatedFramesAreFlaggedAndHeld) {
 // sensor, a wrong tare) must not be "tracked". The bound was raised from 0.15 to 0.30 so that
 // strained, shaded gel under contact stays tracked (tools_test_accuracy
 // TheFlowTracksThePressedGelEverywhere); an unrelated window leaves ~1 of its template energy, and
-// the rare chance match below 0.30 has no two neighbours agreeing with it (neighbour consensus).
+// the rare chance match below 0.30 has no two neighbours agreeing with it (neighbour consensus:
+// with the old "one tracked neighbour suffices" rule, 4 and 2 points of seeds 8 and 9 passed).
 TEST(BlockFlow, AnUnrelatedPatternIsNotTracked) {
   auto f = make_flow();
   for (const std::uint64_t seed : {7u, 8u, 9u}) {
@@ -387,7 +388,7 @@ TEST(BlockFlow, AnUnrelatedPatternIsNotTracked) {
     f->track(test::render_work_image(other, Warp::identity()), d, v);
     std::printf("  pattern seed %d against the tare of seed 42: %d of %d points called tracked\n",
                 static_cast<int>(seed), f->valid_count(), kGridCount);
-    EXPECT_LE(f->valid_count(), kGridCount / 100) << "seed " << seed;
+    EXPECT_EQ(f->valid_count(), 0) << "seed " << seed;
   }
 }
 

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "tacse3/config/calibration_file.hpp"
@@ -232,39 +234,50 @@ TEST(Accuracy, TheFlowTracksThePressedGelEverywhere) {
   const auto src = open_sim(c, &err);
   ASSERT_TRUE(src) << err;
   const tt::SourceInfo& info = src->info();
-  // The default flow, and beside it one with the old bound for the record (printed only).
+  // Per pad, the default flow and beside it one with the old bound (0.15, with today's
+  // consensus rule). The old bound must still lose points here: otherwise the simulator no
+  // longer strains the gel enough for this test to show anything.
   tacse3::dsp::BlockFlowConfig old_bound;
   old_bound.max_residual_ratio = 0.15;
-  std::array<std::unique_ptr<tacse3::dsp::BlockFlow>, 2> flows{
-      std::make_unique<tacse3::dsp::BlockFlow>(),  // ~1 MB each: on the heap in a test
-      std::make_unique<tacse3::dsp::BlockFlow>(old_bound)};
+  constexpr int kPads = 2;
+  std::array<std::unique_ptr<tacse3::dsp::BlockFlow>, 2 * kPads> flows;  // ~1 MB each: heap
+  for (int pad = 0; pad < kPads; ++pad) {
+    flows[2 * pad] = std::make_unique<tacse3::dsp::BlockFlow>();
+    flows[2 * pad + 1] = std::make_unique<tacse3::dsp::BlockFlow>(old_bound);
+  }
   tacse3::dsp::WorkImage img;
   tacse3::dsp::VectorField d;
   tacse3::dsp::GridMask v;
-  // Default timeline: the grasp ends at 0.5 s, the motion runs 0.6-1.6 s.
-  std::array<int, 2> worst_rest{}, worst_motion{};
+  // Default timeline: the grasp ends at 0.5 s, the motion runs 0.6-1.6 s, the hold to the end.
+  std::array<int, 2 * kPads> worst_rest{}, worst_moving{};
   for (std::size_t i = 0; i < info.frame_count(); ++i) {
     std::array<const tacse3::dsp::FrameView*, 2> views{};
     ASSERT_EQ(src->read(i, &views), "");
-    ASSERT_NE(views[0], nullptr);
-    ASSERT_EQ(tacse3::dsp::frame_to_work_image(*views[0], img), tacse3::dsp::Status::kOk);
     const double t = static_cast<double>(info.t_ns[i] - info.t_ns[0]) * 1e-9;
-    for (std::size_t k = 0; k < flows.size(); ++k) {
-      flows[k]->track(img, d, v);
-      const int untracked = tacse3::dsp::kGridCount - flows[k]->valid_count();
-      if (t >= 0.5 && t < 0.6) worst_rest[k] = std::max(worst_rest[k], untracked);
-      if (t >= 0.6 && t < 1.6) worst_motion[k] = std::max(worst_motion[k], untracked);
+    for (int pad = 0; pad < kPads; ++pad) {
+      ASSERT_NE(views[static_cast<std::size_t>(pad)], nullptr);
+      ASSERT_EQ(tacse3::dsp::frame_to_work_image(*views[static_cast<std::size_t>(pad)], img),
+                tacse3::dsp::Status::kOk);
+      for (int k = 2 * pad; k < 2 * pad + 2; ++k) {
+        const auto u = static_cast<std::size_t>(k);
+        flows[u]->track(img, d, v);
+        const int untracked = tacse3::dsp::kGridCount - flows[u]->valid_count();
+        if (t >= 0.5 && t < 0.6) worst_rest[u] = std::max(worst_rest[u], untracked);
+        if (t >= 0.6) worst_moving[u] = std::max(worst_moving[u], untracked);
+      }
     }
   }
   for (std::size_t k = 0; k < flows.size(); ++k) {
-    std::printf("sphere rz 30, left pad, max_residual_ratio %.2f: at most %d of %d flow points "
-                "untracked at rest after the grasp, %d during the torsion\n",
-                flows[k]->config().max_residual_ratio, worst_rest[k], tacse3::dsp::kGridCount,
-                worst_motion[k]);
+    std::printf("sphere rz 30, %s pad, max_residual_ratio %.2f: at most %d of %d flow points "
+                "untracked at rest after the grasp, %d during the torsion and the hold\n",
+                k < 2 ? "left" : "right", flows[k]->config().max_residual_ratio, worst_rest[k],
+                tacse3::dsp::kGridCount, worst_moving[k]);
   }
-  EXPECT_EQ(flows[0]->config().max_residual_ratio, tacse3::dsp::BlockFlowConfig{}.max_residual_ratio);
-  EXPECT_LE(worst_rest[0], tacse3::dsp::kGridCount / 100);
-  EXPECT_LE(worst_motion[0], tacse3::dsp::kGridCount * 3 / 100);
+  for (std::size_t k = 0; k < flows.size(); k += 2) {
+    EXPECT_LE(worst_rest[k], tacse3::dsp::kGridCount / 100) << "pad " << k / 2;
+    EXPECT_LE(worst_moving[k], tacse3::dsp::kGridCount * 3 / 100) << "pad " << k / 2;
+    EXPECT_GT(worst_rest[k + 1], tacse3::dsp::kGridCount * 5 / 100) << "pad " << k / 2;
+  }
 }
 
 }  // namespace
