@@ -10,6 +10,7 @@
 # the detector's per-frame agreement with sim_labels.csv (from tacse3-replay's summary).
 # Recordings are reused from WORK_DIR by name: use a fresh WORK_DIR after changing the simulator.
 set -euo pipefail
+[ $# -le 3 ] || { echo "usage: $0 [BUILD_DIR] [CALIBRATION] [WORK_DIR]" >&2; exit 2; }
 
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 build="$(realpath -m "${1:-$root/build/host}")"
@@ -41,7 +42,7 @@ for c in "${cases[@]}"; do
   read -r motion magnitude <<<"${c#*|}"
   rec="$work/sphere_${motion}${magnitude}_s5"
   if [ ! -f "$rec/recording.json" ]; then
-    rm -rf "$rec.tmp"
+    rm -rf "$rec.tmp" "$rec"   # a folder without recording.json is an interrupted render
     "$sim" -q -o "$rec.tmp" --object sphere --motion "$motion" --magnitude "$magnitude" --seed 5 \
       --colour grey --png-level 0
     mv "$rec.tmp" "$rec"
@@ -52,7 +53,10 @@ for c in "${cases[@]}"; do
     log="$work/$(basename "$rec").$mode.txt"
     "$replay" "$rec" --calibration "$cal" --mode "$mode" --out "$work/$(basename "$rec").$mode.csv" \
       >"$log" 2>&1 || { echo "proxy_table.sh: replay of $rec ($mode) failed, see $log" >&2; exit 1; }
-    row="$row | $(awk '/^  rotation:/ {r = $(NF-1)} /^  translation:/ {t = $(NF-1)} END {printf "%s / %s", r, t}' "$log")"
+    cell="$(awk '/^  rotation:/ {r = $(NF-1)} /^  translation:/ {t = $(NF-1)}
+                 END {if (r == "" || t == "") exit 1; printf "%s / %s", r, t}' "$log")" ||
+      { echo "proxy_table.sh: no error summary in $log (tacse3-replay's output changed?)" >&2; exit 1; }
+    row="$row | $cell"
     if [ "$mode" = auto ]; then
       detector="$(sed -n 's/^  slip detector vs sim_labels.csv: \([0-9.]*%\) of \([0-9]*\) in-contact sensor-frames (\(.*\))$/\1 of \2 (\3)/p' "$log")"
     fi
