@@ -148,6 +148,7 @@ bool StreamWriter::push(std::int64_t t_ns, std::span<const StreamImage> images) 
 void StreamWriter::run() {
   std::array<ImageView, kMaxSensors> views{};
   const std::size_t nsensors = opt_.info.sensors.size();
+  bool wrote = false;
   for (;;) {
     const std::uint32_t seen = wake_.load(std::memory_order_acquire);
     const std::uint64_t tail = tail_.load(std::memory_order_relaxed);
@@ -166,13 +167,18 @@ void StreamWriter::run() {
       const Status st =
           sink_->write_frame(times_[slot], std::span<const ImageView>(views.data(), nsensors));
       if (st.ok()) {
-        bump(n_.written);
+        wrote = true;
       } else {
         fail(st);
       }
     }
     // After a failure the remaining slots are discarded (push() no longer adds any).
     tail_.store(tail + 1, std::memory_order_release);
+    // Counted only once the slot is free again (release, paired with stats()' acquire): a
+    // producer pacing itself on pushed − written < ring_frames then always finds room. Counted
+    // before the release, a push in between was dropped as "ring full" (seen under qemu).
+    if (wrote) n_.written.fetch_add(1, std::memory_order_release);
+    wrote = false;
   }
 }
 
@@ -209,7 +215,7 @@ std::string StreamWriter::error() const {
 StreamWriterStats StreamWriter::stats() const noexcept {
   StreamWriterStats s;
   s.pushed = n_.pushed.load(std::memory_order_relaxed);
-  s.written = n_.written.load(std::memory_order_relaxed);
+  s.written = n_.written.load(std::memory_order_acquire);  // its slot is free (run())
   s.dropped_full = n_.dropped_full.load(std::memory_order_relaxed);
   s.rejected = n_.rejected.load(std::memory_order_relaxed);
   s.after_stop = n_.after_stop.load(std::memory_order_relaxed);

@@ -49,7 +49,7 @@ struct StreamWriterOptions {
 // Counters since start(); readable from any thread.
 struct StreamWriterStats {
   std::uint64_t pushed = 0;        // accepted into the ring
-  std::uint64_t written = 0;       // written by the sink (PNGs + frames.csv row)
+  std::uint64_t written = 0;       // written by the sink (PNGs + frames.csv row), slot freed
   std::uint64_t dropped_full = 0;  // rejected: every slot was waiting for the writer
   std::uint64_t rejected = 0;    // rejected: wrong image count/size/channels or t_ns not increasing
   std::uint64_t after_stop = 0;  // pushes after the recording stopped (failure or close)
