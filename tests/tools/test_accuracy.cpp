@@ -222,7 +222,6 @@ TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
   }
 }
 
-
 // The block flow on the simulator's pressed, shaded, noisy gel: the pattern at the patch is
 // strained (the bulge, the shear) and shaded, so a correct match leaves more residual than on a
 // shifted frame. With the old residual bound (0.15 of the template energy) 12 % of the grid was

@@ -24,7 +24,7 @@ done
 [ -f "$cal" ] || { echo "proxy_table.sh: calibration $cal not found" >&2; exit 2; }
 mkdir -p "$work"
 
-# label | object motion magnitude | regime
+# "label|motion magnitude" (all spheres, seed 5)
 cases=(
   "sphere rz 30° (slide)|rz 30"
   "sphere rx 30° (slide)|rx 30"
@@ -40,7 +40,8 @@ echo "|---|---|---|---|---|"
 for c in "${cases[@]}"; do
   label="${c%%|*}"
   read -r motion magnitude <<<"${c#*|}"
-  rec="$work/sphere_${motion}${magnitude}_s5"
+  name="sphere_${motion}${magnitude}_s5"
+  rec="$work/$name"
   if [ ! -f "$rec/recording.json" ]; then
     rm -rf "$rec.tmp" "$rec"   # a folder without recording.json is an interrupted render
     "$sim" -q -o "$rec.tmp" --object sphere --motion "$motion" --magnitude "$magnitude" --seed 5 \
@@ -50,8 +51,8 @@ for c in "${cases[@]}"; do
   row="| $label"
   detector=""
   for mode in auto velocity displacement; do
-    log="$work/$(basename "$rec").$mode.txt"
-    "$replay" "$rec" --calibration "$cal" --mode "$mode" --out "$work/$(basename "$rec").$mode.csv" \
+    log="$work/$name.$mode.txt"
+    "$replay" "$rec" --calibration "$cal" --mode "$mode" --out "$work/$name.$mode.csv" \
       >"$log" 2>&1 || { echo "proxy_table.sh: replay of $rec ($mode) failed, see $log" >&2; exit 1; }
     cell="$(awk '/^  rotation:/ {r = $(NF-1)} /^  translation:/ {t = $(NF-1)}
                  END {if (r == "" || t == "") exit 1; printf "%s / %s", r, t}' "$log")" ||

@@ -148,7 +148,6 @@ bool StreamWriter::push(std::int64_t t_ns, std::span<const StreamImage> images) 
 void StreamWriter::run() {
   std::array<ImageView, kMaxSensors> views{};
   const std::size_t nsensors = opt_.info.sensors.size();
-  bool wrote = false;
   for (;;) {
     const std::uint32_t seen = wake_.load(std::memory_order_acquire);
     const std::uint64_t tail = tail_.load(std::memory_order_relaxed);
@@ -158,6 +157,7 @@ void StreamWriter::run() {
       wake_.wait(seen, std::memory_order_acquire);
       continue;
     }
+    bool wrote = false;
     if (!failed_.load(std::memory_order_acquire)) {
       const std::size_t slot = static_cast<std::size_t>(tail % nslots_);
       const std::uint8_t* src = pixels_.get() + slot * slot_bytes_;
@@ -178,7 +178,6 @@ void StreamWriter::run() {
     // producer pacing itself on pushed − written < ring_frames then always finds room. Counted
     // before the release, a push in between was dropped as "ring full" (seen under qemu).
     if (wrote) n_.written.fetch_add(1, std::memory_order_release);
-    wrote = false;
   }
 }
 
