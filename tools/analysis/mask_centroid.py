@@ -8,9 +8,12 @@ below --gate (what the sliding translation rule kept with that `max_mask_change`
 exceeded it, and, at the first and last frame in contact, the mask centroid, the number of cells
 of each connected component of the mask, the centroid of the largest component alone, the
 centroid weighted by the contact points' height z, and (with --recording, a simulator recording
-holding sim_labels.csv) the simulator's true patch centroid.
+holding sim_labels.csv) the simulator's true patch centroid. With --frames, the same z-weighted
+centroid at each listed frame against the simulator's, with the mask's size and how many of its
+cells lie within --border grid cells of the pad's edge (docs/accuracy.md item 5).
 
-Usage: mask_centroid.py DIR [--gate 0.3] [--recording REC_DIR]   (docs/dsp.md section 4.1)
+Usage: mask_centroid.py DIR [--gate 0.3] [--recording REC_DIR] [--frames 72,239 [--border 3]]
+(docs/dsp.md section 4.1)
 """
 import argparse
 import csv
@@ -50,6 +53,34 @@ def sim_centroids(recording, pad):
             if row["sensor"] == pad:
                 out[int(row["index"])] = (float(row["centroid_u_mm"]), float(row["centroid_v_mm"]))
     return out
+
+
+def frame_report(folder, pad, recording, frames, border):
+    """Per listed frame: the z-weighted mask centroid against the simulator's patch centroid."""
+    mask, shape = load_npy(f"{folder}/{pad}/mask.npy")
+    points, _ = load_npy(f"{folder}/{pad}/points.npy")
+    truth = sim_centroids(recording, pad) if recording else {}
+    for n in frames:
+        if not 0 <= n < shape[0]:
+            print(f"{pad}: frame {n} is not in the dump ({shape[0]} frames)")
+            continue
+        cells = [i for i in range(CELLS) if mask[n * CELLS + i]]
+        if not cells:
+            print(f"{pad}: frame {n}: no contact")
+            continue
+        w = [points[3 * (n * CELLS + i) + 2] for i in cells]
+        total = sum(w) or 1.0
+        c = [sum(wi * points[3 * (n * CELLS + i) + k] for wi, i in zip(w, cells)) / total * 1e3
+             for k in range(2)]
+        at_edge = sum(1 for i in cells
+                      if min(i % GRID_W, GRID_W - 1 - i % GRID_W,
+                             i // GRID_W, GRID_H - 1 - i // GRID_W) < border)
+        line = (f"{pad}: frame {n}: z-weighted centroid ({c[0]:.3f}, {c[1]:.3f}) mm, "
+                f"{len(cells)} cells, {at_edge} within {border} of the edge")
+        if n in truth:
+            line += (f", simulator ({truth[n][0]:.3f}, {truth[n][1]:.3f}) mm, "
+                     f"difference ({c[0] - truth[n][0]:+.3f}, {c[1] - truth[n][1]:+.3f}) mm")
+        print(line)
 
 
 def pad_report(folder, pad, gate, recording):
@@ -115,11 +146,20 @@ def main():
     ap.add_argument("dir", help="tacse3-replay --dump-fields folder")
     ap.add_argument("--gate", type=float, default=0.3, help="max_mask_change to evaluate")
     ap.add_argument("--recording", help="the replayed simulator recording (for sim_labels.csv)")
+    ap.add_argument("--frames", help="comma-separated frame indices: the centroid at each instead")
+    ap.add_argument("--border", type=int, default=3, help="edge band for --frames, grid cells")
     a = ap.parse_args()
+    try:
+        frames = [int(f) for f in a.frames.split(",")] if a.frames else None
+    except ValueError:
+        sys.exit(f"mask_centroid.py: --frames {a.frames!r}: expected comma-separated integers")
     for pad in ("left", "right"):
         if not os.path.exists(f"{a.dir}/{pad}/mask.npy"):
             continue
-        pad_report(a.dir, pad, a.gate, a.recording)
+        if frames is not None:
+            frame_report(a.dir, pad, a.recording, frames, a.border)
+        else:
+            pad_report(a.dir, pad, a.gate, a.recording)
 
 
 if __name__ == "__main__":
