@@ -185,6 +185,7 @@ Status MotionEstimator::configure(const Calibration& cal) noexcept {
 void MotionEstimator::reset_detector() noexcept {
   slipping_ = false;
   evidence_frames_ = 0;
+  unloaded_rest_frames_ = 0;
   rest_s_ = 0.0;
   peak_shift_m_ = 0.0;
   content_.setZero();
@@ -302,12 +303,19 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
             out.shear_shift_m > min_shift_m_ && out.slip_relax_rate > relax_rate_on_;
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
         rest_s_ = rest ? rest_s_ + dt_s : 0.0;
+        // A contact carrying no more shear than a slip onset needs cannot be in the first half
+        // of a slide (that half builds the shear up), so at rest it is stuck after as many frames
+        // as an onset takes; a loaded contact at rest may be sliding steadily and needs
+        // stick_confirm_s. This drops what the velocity proxy read while the contact formed
+        // (docs/accuracy.md item 5: the weighted centroid of a growing mask moves by ~0.2 mm).
+        const bool unloaded = out.shear_shift_m <= min_shift_m_;
+        unloaded_rest_frames_ = rest && unloaded ? unloaded_rest_frames_ + 1 : 0;
         if (evidence_frames_ >= on_frames_) {
           slipping_ = true;
           out.slip_onset = true;
           evidence_frames_ = 0;
           peak_shift_m_ = out.shear_shift_m;
-        } else if (rest_s_ >= confirm_s_) {
+        } else if (rest_s_ >= confirm_s_ || unloaded_rest_frames_ >= on_frames_) {
           out.stick_confirmed = true;
         }
       } else {

@@ -21,8 +21,10 @@ Vector6d SlipPayback::update(const Frame& f, double dt_s) noexcept {
   }
   // This frame still used the proxies decided before it: book what the velocity proxy adds.
   if (f.differs) deficit_ += (f.velocity - f.chosen) * dt_s;
-  if (f.confirmed) {
-    reset();  // a confirmed stick: what the velocity proxy read was the grasp's residual shear
+  if (f.confirmed && left_ == 0) {
+    // A confirmed stick: what the velocity proxy read was the grasp's residual shear. A payback
+    // under way is a slide already detected, so a stick confirmed after it does not cut it.
+    reset();
     return f.chosen;
   }
   if (f.onset) left_ = catchup_frames_;  // a second sensor's onset restarts the spread

@@ -296,6 +296,45 @@ TEST(SlipDetector, AStuckContactLosingItsRimStaysStuck) {
   EXPECT_NEAR(integrate_z(t.omega_ref), 4.0 * kDeg, 0.02 * kDeg);
 }
 
+// When a contact at rest counts as stuck, which drops the velocity proxy's pending reading. An
+// unloaded contact (|X| ≤ slip_min_shift_m, no tangential load to speak of) cannot be in the first
+// half of a slide, which builds the shear up: it is stuck after slip_on_frames frames at rest. A
+// loaded one at rest may be sliding steadily at the friction limit, so it needs stick_confirm_s.
+// The reference decides on the same frames.
+TEST(SlipDetector, AnUnloadedContactAtRestIsConfirmedStuckAfterOnsetFrames) {
+  const Calibration cal = auto_cal();
+  ASSERT_GT(cal.slip_on_frames, 1);
+  const Disc disc;
+  for (const double shift_m : {0.0, 0.5 * cal.slip_min_shift_m, 3.0 * cal.slip_min_shift_m}) {
+    auto est = std::make_unique<MotionEstimator>();
+    ASSERT_EQ(est->configure(cal), Status::kOk);
+    dsp_ref::MotionRef ref(cal);
+    auto sh = std::make_unique<VectorField>();
+    std::vector<double> sx, sy;
+    disc.shear(0.0, shift_m, cal.c_displacement, *sh, sx, sy);
+    int first = -1, first_ref = -1;
+    const int frames = static_cast<int>(std::lround(1.5 * cal.stick_confirm_s / kDt));
+    for (int k = 0; k < frames; ++k) {
+      SensorMotion m;
+      ASSERT_EQ(est->update(*disc.cs, *sh, kDt, m), Status::kOk);
+      const dsp_ref::SensorMotionRef mr = ref.update(disc.ref, sx, sy, kDt);
+      ASSERT_FALSE(m.slipping);
+      if (first < 0 && m.stick_confirmed) first = k;
+      if (first_ref < 0 && mr.stick_confirmed) first_ref = k;
+    }
+    // The first frame has no previous shear, so its change reads zero: at rest from frame 0.
+    if (shift_m <= cal.slip_min_shift_m) {
+      EXPECT_EQ(first, cal.slip_on_frames - 1) << "shift " << shift_m;
+    } else {
+      // Σ Δt reaches stick_confirm_s on frame 119 or, by the sum's rounding, the next one.
+      const int at = static_cast<int>(std::lround(cal.stick_confirm_s / kDt)) - 1;
+      EXPECT_GE(first, at) << "shift " << shift_m;
+      EXPECT_LE(first, at + 1) << "shift " << shift_m;
+    }
+    EXPECT_EQ(first_ref, first) << "shift " << shift_m;
+  }
+}
+
 TEST(SlipDetector, SlideIsDetectedWhenTheShearRelaxesAndThePoseCatchesUp) {
   // A slide: the shear follows the sliding speed (gel lag ignored), rising and falling with a
   // minimum-jerk speed profile of a 30° rotation over 1 s, then 0.5 s at rest. The velocity

@@ -80,6 +80,39 @@ TEST(SlipPayback, AConfirmedStickContactLossOrResetDropsTheDeficit) {
   }
 }
 
+// A stick confirmed while a payback is under way (an unloaded contact settles within the catch-up
+// window after a short slide) does not cut the payback: the slide was already detected.
+TEST(SlipPayback, AStickConfirmedDuringAPaybackDoesNotCutIt) {
+  for (const bool ref_side : {false, true}) {
+    SlipPayback p;
+    p.configure(8);
+    dsp_ref::SlipPaybackRef r(8);
+    const Vector6d chosen = Vector6d::Zero(), velocity = twist(0.9, 1e-3);
+    double paid = 0.0;
+    auto step = [&](const SlipPayback::Frame& f) {
+      const Vector6d out = ref_side ? r.update(f.chosen, f.velocity, f.differs, f.contact, f.onset,
+                                               f.confirmed, false, kDt)
+                                    : p.update(f, kDt);
+      paid += (out(2) - f.chosen(2)) * kDt;
+    };
+    for (int k = 0; k < 20; ++k) step(stuck(chosen, velocity));
+    SlipPayback::Frame onset = stuck(chosen, chosen);
+    onset.onset = true;
+    step(onset);
+    for (int k = 0; k < 7; ++k) {
+      SlipPayback::Frame f = stuck(chosen, chosen);
+      f.confirmed = k >= 2;  // confirmed from the third frame after the onset on
+      step(f);
+    }
+    EXPECT_NEAR(paid, 20 * kDt * velocity(2), 1e-12) << (ref_side ? "reference" : "fixed");
+    // Once the payback is over, a confirmation drops what was booked after it.
+    SlipPayback::Frame late = stuck(chosen, velocity);
+    late.confirmed = true;
+    step(late);
+    EXPECT_NEAR(paid, 20 * kDt * velocity(2), 1e-12) << (ref_side ? "reference" : "fixed");
+  }
+}
+
 // A second sensor's onset during a payback spreads what is left over a full window again.
 TEST(SlipPayback, ASecondOnsetRestartsTheSpread) {
   SlipPayback p;

@@ -75,6 +75,7 @@ MotionRef::MotionRef(const dsp::Calibration& cal) : cal_(cal) {
 void MotionRef::reset_detector() {
   slipping_ = false;
   evidence_frames_ = 0;
+  unloaded_rest_frames_ = 0;
   rest_s_ = 0.0;
   peak_shift_m_ = 0.0;
   content_.setZero();
@@ -205,12 +206,16 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
                               out.slip_relax_rate > cal_.slip_relax_rate_on;
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
         rest_s_ = rest ? rest_s_ + dt : 0.0;
+        // Unloaded (|X| ≤ slip_min_shift_m) and at rest for slip_on_frames frames: stuck.
+        const bool unloaded = out.shear_shift_m <= cal_.slip_min_shift_m;
+        unloaded_rest_frames_ = rest && unloaded ? unloaded_rest_frames_ + 1 : 0;
         if (evidence_frames_ >= cal_.slip_on_frames) {
           slipping_ = true;
           out.slip_onset = true;
           evidence_frames_ = 0;
           peak_shift_m_ = out.shear_shift_m;
-        } else if (rest_s_ >= cal_.stick_confirm_s) {
+        } else if (rest_s_ >= cal_.stick_confirm_s ||
+                   unloaded_rest_frames_ >= cal_.slip_on_frames) {
           out.stick_confirmed = true;
         }
       } else {
@@ -311,7 +316,7 @@ dsp::Vector6d SlipPaybackRef::update(const dsp::Vector6d& chosen, const dsp::Vec
   }
   if (!contact) return chosen;
   if (differs) deficit_ += (velocity - chosen) * dt;
-  if (confirmed) {
+  if (confirmed && left_ == 0) {
     deficit_.setZero();
     left_ = 0;
     return chosen;

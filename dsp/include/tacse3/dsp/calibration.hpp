@@ -91,8 +91,10 @@ struct Calibration {
   double stick_rest_speed_m_s = 0.05e-3;
   // A sticking contact whose shear content stayed at rest (|dX|/Δt < stick_rest_speed_m_s) for
   // stick_confirm_s is confirmed stuck; once every sensor in contact is, the pending payback is
-  // dropped: a slide relaxes within a few lag times of the gel, a stuck contact holds its shear.
-  // [0, 10] s.
+  // dropped (unless a payback is under way): a slide relaxes within a few lag times of the gel, a
+  // stuck contact holds its shear. An unloaded contact (|X| ≤ slip_min_shift_m) at rest is
+  // confirmed after slip_on_frames frames: without tangential load it cannot be in a slide's
+  // first half, and its grasp is then not paid back as motion. [0, 10] s.
   double stick_confirm_s = 1.0;
   // Frames over which the deficit (what the velocity proxy would have added while the slip still
   // looked like a stick) is paid back after a slip onset, so the pose catches up without a jump.

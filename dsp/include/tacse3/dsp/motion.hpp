@@ -197,6 +197,7 @@ class MotionEstimator {
   double confirm_s_ = 0.0;
   bool slipping_ = false;
   int evidence_frames_ = 0;
+  int unloaded_rest_frames_ = 0;  // consecutive frames at rest with |X| ≤ slip_min_shift_m
   double rest_s_ = 0.0;
   double peak_shift_m_ = 0.0;
   double smoothing_s_ = 0.0;

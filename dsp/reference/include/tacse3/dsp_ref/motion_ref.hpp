@@ -100,6 +100,7 @@ class MotionRef {
   // kAuto detector state (dsp::MotionEstimator's, in double).
   bool slipping_ = false;
   int evidence_frames_ = 0;
+  int unloaded_rest_frames_ = 0;
   double rest_s_ = 0.0;
   double peak_shift_m_ = 0.0;
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();
