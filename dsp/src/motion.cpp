@@ -303,11 +303,13 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
             out.shear_shift_m > min_shift_m_ && out.slip_relax_rate > relax_rate_on_;
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
         rest_s_ = rest ? rest_s_ + dt_s : 0.0;
-        // A contact carrying no more shear than a slip onset needs cannot be in the first half
-        // of a slide (that half builds the shear up), so at rest it is stuck after as many frames
-        // as an onset takes; a loaded contact at rest may be sliding steadily and needs
-        // stick_confirm_s. This drops what the velocity proxy read while the contact formed
-        // (docs/accuracy.md item 5: the weighted centroid of a growing mask moves by ~0.2 mm).
+        // Unloaded (|X| ≤ slip_min_shift_m, the least shift an onset needs): any slide it could be
+        // in is slower than slip_min_shift_m · c_velocity / c_displacement (≈ 0.6 mm/s with the
+        // simulator's calibration), one the detector could never call either. At rest for
+        // slip_on_frames frames (the first frame of a contact counts, its change reads zero) it
+        // is confirmed stuck; a loaded contact at rest may be sliding steadily at the friction
+        // limit and needs stick_confirm_s. This drops what the velocity proxy read while the
+        // contact formed (docs/accuracy.md item 5: a growing mask's centroid moves ~0.2 mm).
         const bool unloaded = out.shear_shift_m <= min_shift_m_;
         unloaded_rest_frames_ = rest && unloaded ? unloaded_rest_frames_ + 1 : 0;
         if (evidence_frames_ >= on_frames_) {

@@ -105,10 +105,12 @@ TEST(SlipPayback, AStickConfirmedDuringAPaybackDoesNotCutIt) {
       step(f);
     }
     EXPECT_NEAR(paid, 20 * kDt * velocity(2), 1e-12) << (ref_side ? "reference" : "fixed");
-    // Once the payback is over, a confirmation drops what was booked after it.
+    // Once the payback is over, a confirmation drops what was booked: a later onset pays nothing.
     SlipPayback::Frame late = stuck(chosen, velocity);
     late.confirmed = true;
     step(late);
+    step(onset);
+    for (int k = 0; k < 8; ++k) step(stuck(chosen, chosen));
     EXPECT_NEAR(paid, 20 * kDt * velocity(2), 1e-12) << (ref_side ? "reference" : "fixed");
   }
 }

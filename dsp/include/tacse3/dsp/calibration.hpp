@@ -90,11 +90,12 @@ struct Calibration {
   double slip_exit_fraction = 0.25;
   double stick_rest_speed_m_s = 0.05e-3;
   // A sticking contact whose shear content stayed at rest (|dX|/Δt < stick_rest_speed_m_s) for
-  // stick_confirm_s is confirmed stuck; once every sensor in contact is, the pending payback is
-  // dropped (unless a payback is under way): a slide relaxes within a few lag times of the gel, a
-  // stuck contact holds its shear. An unloaded contact (|X| ≤ slip_min_shift_m) at rest is
-  // confirmed after slip_on_frames frames: without tangential load it cannot be in a slide's
-  // first half, and its grasp is then not paid back as motion. [0, 10] s.
+  // stick_confirm_s ([0, 10] s) is confirmed stuck; once every sensor in contact is, the pending
+  // payback is dropped (unless a payback is under way): a slide relaxes within a few lag times of
+  // the gel, a stuck contact holds its shear. An unloaded contact (|X| ≤ slip_min_shift_m, so
+  // sliding, if at all, slower than slip_min_shift_m · c_velocity / c_displacement) at rest is
+  // confirmed after slip_on_frames frames, so its grasp is not paid back as motion; the two onset
+  // thresholds thus also set this confirmation.
   double stick_confirm_s = 1.0;
   // Frames over which the deficit (what the velocity proxy would have added while the slip still
   // looked like a stick) is paid back after a slip onset, so the pose catches up without a jump.
