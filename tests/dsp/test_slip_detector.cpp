@@ -297,8 +297,8 @@ TEST(SlipDetector, AStuckContactLosingItsRimStaysStuck) {
 }
 
 // When a contact at rest counts as stuck, which drops the velocity proxy's pending reading. An
-// unloaded contact (|X| ≤ slip_min_shift_m, no tangential load to speak of) cannot be in the first
-// half of a slide, which builds the shear up: it is stuck after slip_on_frames frames at rest. A
+// unloaded contact (|X| ≤ slip_min_shift_m, no tangential load to speak of; sliding, if at all,
+// slower than any slide the detector could call) is stuck after slip_on_frames frames at rest. A
 // loaded one at rest may be sliding steadily at the friction limit, so it needs stick_confirm_s.
 // The reference decides on the same frames.
 TEST(SlipDetector, AnUnloadedContactAtRestIsConfirmedStuckAfterOnsetFrames) {

@@ -55,6 +55,16 @@ def sim_centroids(recording, pad):
     return out
 
 
+def centroid_mm(points, n, cells, weighted=False):
+    """Mask centroid (x, y, mm) of frame n over cells; weighted: by the contact point's height z
+    (the indentation estimate from f^z), as the sliding translation rule weights it."""
+    w = [points[3 * (n * CELLS + i) + 2] if weighted else 1.0 for i in cells]
+    total = sum(w) or 1.0
+    sx = sum(wi * points[3 * (n * CELLS + i)] for wi, i in zip(w, cells))
+    sy = sum(wi * points[3 * (n * CELLS + i) + 1] for wi, i in zip(w, cells))
+    return sx / total * 1e3, sy / total * 1e3
+
+
 def frame_report(folder, pad, recording, frames, border):
     """Per listed frame: the z-weighted mask centroid against the simulator's patch centroid."""
     mask, shape = load_npy(f"{folder}/{pad}/mask.npy")
@@ -68,10 +78,7 @@ def frame_report(folder, pad, recording, frames, border):
         if not cells:
             print(f"{pad}: frame {n}: no contact")
             continue
-        w = [points[3 * (n * CELLS + i) + 2] for i in cells]
-        total = sum(w) or 1.0
-        c = [sum(wi * points[3 * (n * CELLS + i) + k] for wi, i in zip(w, cells)) / total * 1e3
-             for k in range(2)]
+        c = centroid_mm(points, n, cells, weighted=True)
         at_edge = sum(1 for i in cells
                       if min(i % GRID_W, GRID_W - 1 - i % GRID_W,
                              i // GRID_W, GRID_H - 1 - i // GRID_W) < border)
@@ -92,14 +99,6 @@ def pad_report(folder, pad, gate, recording):
     def cells_of(n):
         return {i for i in range(CELLS) if mask[n * CELLS + i]}
 
-    def centroid_mm(n, cells, weighted=False):
-        # weighted: by the contact point's height z (the indentation estimate from f^z)
-        w = [points[3 * (n * CELLS + i) + 2] if weighted else 1.0 for i in cells]
-        total = sum(w) or 1.0
-        sx = sum(wi * points[3 * (n * CELLS + i)] for wi, i in zip(w, cells))
-        sy = sum(wi * points[3 * (n * CELLS + i) + 1] for wi, i in zip(w, cells))
-        return sx / total * 1e3, sy / total * 1e3
-
     all_steps, kept_steps = [0.0, 0.0], [0.0, 0.0]
     over_gate = 0
     prev, prev_c = None, None
@@ -109,7 +108,7 @@ def pad_report(folder, pad, gate, recording):
         if not cells:
             prev = None
             continue
-        c = centroid_mm(n, cells)
+        c = centroid_mm(points, n, cells)
         if first is None:
             first = (n, cells, c)
         last = (n, cells, c)
@@ -131,8 +130,8 @@ def pad_report(folder, pad, gate, recording):
           f"({kept_steps[0]:.3f}, {kept_steps[1]:.3f}) mm; {over_gate} frame(s) above it")
     for label, (n, cells, c) in (("first", first), ("last", last)):
         comps = components(cells)
-        big = centroid_mm(n, comps[0])
-        zw = centroid_mm(n, cells, weighted=True)
+        big = centroid_mm(points, n, comps[0])
+        zw = centroid_mm(points, n, cells, weighted=True)
         line = (f"{pad}: {label} frame in contact {n}: mask centroid ({c[0]:.3f}, {c[1]:.3f}) mm, "
                 f"components {[len(k) for k in comps]}, largest component's centroid "
                 f"({big[0]:.3f}, {big[1]:.3f}) mm, z-weighted centroid ({zw[0]:.3f}, {zw[1]:.3f}) mm")

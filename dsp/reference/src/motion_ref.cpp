@@ -316,9 +316,8 @@ dsp::Vector6d SlipPaybackRef::update(const dsp::Vector6d& chosen, const dsp::Vec
   }
   if (!contact) return chosen;
   if (differs) deficit_ += (velocity - chosen) * dt;
-  if (confirmed && left_ == 0) {
+  if (confirmed && left_ == 0) {  // a payback under way is not cut (dsp::SlipPayback)
     deficit_.setZero();
-    left_ = 0;
     return chosen;
   }
   if (onset) left_ = std::max(1, catchup_frames_);

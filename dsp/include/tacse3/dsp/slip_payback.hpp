@@ -13,7 +13,8 @@ namespace tacse3::dsp {
 // would have added to the pose. At a slip onset D is paid back over k = slip_catchup_frames
 // frames (D/left per frame, so the pose catches up without a jump); once every sensor in contact
 // has confirmed its stick, D is dropped, unless a payback is under way (the slide was detected).
-// Keeping D in the fused twist, not per grid cell, makes the payback exactly the integral of what was missed, whatever Ω and its levers did meanwhile.
+// Keeping D in the fused twist, not per grid cell, makes the payback exactly the integral of what
+// was missed, whatever Ω and its levers did meanwhile.
 // Scaling: all in double (SI); D is bounded by what the fused twists can reach (finite inputs).
 class SlipPayback {
  public:
