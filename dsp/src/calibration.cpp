@@ -46,6 +46,7 @@ Status validate(const Calibration& c) noexcept {
   ok = ok && in_range_open_lo(c.c_velocity, 0.0, 100.0);
   ok = ok && in_range_open_lo(c.c_displacement, 0.0, 1.0);
   ok = ok && in_range(c.max_mask_change, 0.0, 1.0);
+  ok = ok && in_range(c.max_mask_area_ratio, 1.0, 1e4);
   for (int a = 0; a < 3; ++a) {
     ok = ok && in_range(c.rotation_scale[static_cast<std::size_t>(a)], 0.0, 100.0);
     ok = ok && in_range(c.translation_scale[static_cast<std::size_t>(a)], 0.0, 100.0);

@@ -159,6 +159,7 @@ Status MotionEstimator::configure(const Calibration& cal) noexcept {
   c_velocity_ = cal.c_velocity;
   c_displacement_ = cal.c_displacement;
   max_mask_change_ = cal.max_mask_change;
+  max_mask_area_ratio_ = cal.max_mask_area_ratio;
   rotation_scale_ =
       Eigen::Vector3d(cal.rotation_scale[0], cal.rotation_scale[1], cal.rotation_scale[2]);
   displacement_rotation_scale_ = rotation_scale_.cwiseProduct(
@@ -361,6 +362,10 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   out.translation_point_m = out.centroid_m;
   const std::int64_t uni = m.n + prev_count_ - common;
   out.mask_change = uni > 0 ? 1.0 - static_cast<double>(common) / static_cast<double>(uni) : 1.0;
+  // Area ratio, larger cell count over smaller (exact in double: counts ≤ kGridCells).
+  const std::int64_t larger = std::max(m.n, prev_count_), smaller = std::min(m.n, prev_count_);
+  const bool area_steady =
+      static_cast<double>(larger) <= max_mask_area_ratio_ * static_cast<double>(smaller);
   if (m.n > 0 && prev_count_ > 0) {
     // Rule of the sliding regime: mask centroid, or the common points if the mask jumped.
     Eigen::Vector2d slide_disp = Eigen::Vector2d::Zero();
@@ -375,7 +380,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     if (common == 0) {
       // Ω_t and Ω_{t−1} share no cell: unrelated contacts (one vanished as another appeared),
       // not a slide, which moves a patch by a fraction of its size per frame. No translation.
-    } else if (out.mask_change <= max_mask_change_) {
+    } else if (out.mask_change <= max_mask_change_ && area_steady) {
       if (weighted) {
         const double wt = static_cast<double>(m.sz), wp = static_cast<double>(prev_sz_);
         slide_disp.x() =

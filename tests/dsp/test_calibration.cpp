@@ -57,6 +57,7 @@ std::vector<BadCase> bad_cases() {
   add("c_velocity NaN", [](Calibration& c) { c.c_velocity = kNan; });
   add("c_displacement inf", [](Calibration& c) { c.c_displacement = kInf; });
   add("mask change NaN", [](Calibration& c) { c.max_mask_change = kNan; });
+  add("area ratio NaN", [](Calibration& c) { c.max_mask_area_ratio = kNan; });
   add("rot scale NaN", [](Calibration& c) { c.rotation_scale[1] = kNan; });
   add("trans scale inf", [](Calibration& c) { c.translation_scale[2] = kInf; });
   add("lambda NaN", [](Calibration& c) { c.solve_lambda_rel = kNan; });
@@ -83,6 +84,8 @@ std::vector<BadCase> bad_cases() {
   add("min area > grid", [](Calibration& c) { c.contact_min_area_cells = kGridCount + 1; });
   add("height max 2 cm", [](Calibration& c) { c.height_max_m = 0.02; });
   add("mask change 1.5", [](Calibration& c) { c.max_mask_change = 1.5; });
+  add("area ratio below 1", [](Calibration& c) { c.max_mask_area_ratio = 0.99; });
+  add("area ratio 1e5", [](Calibration& c) { c.max_mask_area_ratio = 1e5; });
   add("scale 1000", [](Calibration& c) { c.translation_scale[0] = 1000.0; });
   add("L = 0", [](Calibration& c) { c.moving_average_length = 0; });
   add("L > max", [](Calibration& c) { c.moving_average_length = kMaxMovingAverage + 1; });
@@ -106,6 +109,9 @@ TEST(Calibration, RangeBoundsAreInclusiveWhereDocumented) {
   c.moving_average_length = kMaxMovingAverage;
   c.height_gain_m = 0.0;  // flat contact points, allowed
   c.max_mask_change = 1.0;
+  c.max_mask_area_ratio = 1.0;  // every area change reads the material points, allowed
+  EXPECT_EQ(validate(c), Status::kOk);
+  c.max_mask_area_ratio = 1e4;  // off
   EXPECT_EQ(validate(c), Status::kOk);
 }
 

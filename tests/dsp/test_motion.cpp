@@ -475,6 +475,56 @@ TEST(Motion, LargeAreaChangeUsesCommonPointsInsteadOfTheCentroidJump) {
   EXPECT_EQ(m2.translation_source, TranslationSource::kCentroid);
 }
 
+TEST(Motion, AContactFormingAtACornerReadsTheMaterialPointsNotTheCentroidJump) {
+  // A flat face is first seen at one corner (a few cells), and one frame later over its whole
+  // face: the mask's centroid jumps by millimetres while nothing moves (the simulator's textured
+  // cube: 4 cells, then 250, docs/dsp.md §4.1). The area-ratio bound (default 1.5) reads that
+  // frame from the material points in both masks; with the bound off (1e4) the sliding rule
+  // reports the jump as a translation of ~0.4 m/s. A patch that only changes its area by less
+  // than the bound keeps the centroid rule, and the double reference decides the same.
+  for (double bound : {1.5, 1e4}) {
+    Calibration cal;
+    cal.velocity_proxy = VelocityProxy::kVelocity;
+    cal.max_mask_area_ratio = bound;
+    RigidContactScene corner, face, smaller_face;
+    corner.contact_centre_G = Eigen::Vector3d(-3e-3, 2e-3, 0.0);
+    corner.radius_m = 1.5e-3;
+    face.radius_m = 5e-3;
+    smaller_face.radius_m = 4.4e-3;  // area ratio (5 / 4.4)^2 ≈ 1.3 < 1.5
+    const VectorField still;  // zero-initialised: the gel does not move
+    Runner run(cal);
+    dsp_ref::ContactDetectorRef rdet(cal);
+    dsp_ref::MotionRef rme(cal);
+    const std::vector<double> zero(static_cast<std::size_t>(kGridCount), 0.0);
+    auto both = [&](const RigidContactScene& sc) {
+      const SyntheticSensorFrames f = dsp_ref::render_rigid_contact(cal, sc);
+      const SensorMotion m = run.frame(f.fz, still, still);
+      std::vector<double> fz(static_cast<std::size_t>(kGridCount));
+      for (std::size_t i = 0; i < fz.size(); ++i) fz[i] = from_q<16>(f.fz.v[i]);
+      const dsp_ref::SensorMotionRef r = rme.update(rdet.detect(fz, still, f.valid), zero, zero, kDt);
+      EXPECT_EQ(m.translation_source, static_cast<TranslationSource>(r.translation_source));
+      // The weighted centroid's heights go through the Q16 filter (≈ 4 nm per frame, 0.5 µm/s).
+      EXPECT_LT((m.translation - r.translation).norm(), 1e-6 + 2e-5 * r.translation.norm());
+      return m;
+    };
+    const SensorMotion m0 = both(corner);
+    const SensorMotion m1 = both(face);
+    ASSERT_GT(m1.points, 1.5 * m0.points);
+    ASSERT_TRUE(m1.translation_valid);
+    if (bound == 1.5) {
+      EXPECT_EQ(m1.translation_source, TranslationSource::kCommonPoints);
+      EXPECT_LT(m1.translation.norm(), 1e-6);
+    } else {
+      EXPECT_EQ(m1.translation_source, TranslationSource::kCentroid);
+      EXPECT_GT(m1.translation.norm(), 0.2);
+    }
+    // The face shrinks a little (pressure released): within the bound, the centroid rule.
+    const SensorMotion m2 = both(smaller_face);
+    ASSERT_LT(m1.points, 1.5 * m2.points);
+    EXPECT_EQ(m2.translation_source, TranslationSource::kCentroid) << bound;
+  }
+}
+
 TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
   // A sliding patch whose mask advances in bursts, as Ω read from 𝒢 does in the simulator's
   // 10 mm slides (a third of the cells enter or leave in one frame): the patch stands still for
@@ -537,6 +587,9 @@ TEST(Motion, SlidingCentroidIsWeightedByHeightSoAHysteresisTrailHardlyMovesIt) {
   // height-weighted one, which the sliding rule reads, much less.
   Calibration cal;
   cal.velocity_proxy = VelocityProxy::kVelocity;
+  // The one-frame 6 mm step with its trail doubles Ω's area, which the area-ratio bound would
+  // read as a contact forming (previous test); this test isolates the weighting.
+  cal.max_mask_area_ratio = 1e4;
   RigidContactScene before, after;
   before.contact_centre_G = Eigen::Vector3d(-3e-3, 0.0, 0.0);
   after.contact_centre_G = Eigen::Vector3d(3e-3, 0.0, 0.0);

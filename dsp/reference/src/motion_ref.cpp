@@ -258,7 +258,10 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     if (common > 0) common_d = sum_common / common;
     if (common == 0) {
       // No cell in both masks: unrelated contacts, no translation (dsp::MotionEstimator's rule).
-    } else if (change <= cal_.max_mask_change) {
+    } else if (change <= cal_.max_mask_change &&
+               std::max(out.points, prev_count) <=
+                   cal_.max_mask_area_ratio * std::min(out.points, prev_count)) {
+      // A forming or vanishing contact (area ratio above the bound) reads the common points.
       slide = weighted ? Eigen::Vector3d(zsum_now / z_now - zsum_prev / z_prev)
                        : Eigen::Vector3d(sum_now / out.points - sum_prev / prev_count);
       slide_source = 1;

@@ -78,6 +78,8 @@ const std::vector<Field>& fields() {
        &Calibration::slip_catchup_frames},
       {"slip_smoothing_s", Field::kReal, 0.0, 1.0, false, false, &Calibration::slip_smoothing_s},
       {"max_mask_change", Field::kReal, 0.0, 1.0, false, false, &Calibration::max_mask_change},
+      {"max_mask_area_ratio", Field::kReal, 1.0, 1e4, false, false,
+       &Calibration::max_mask_area_ratio},
       {"rotation_scale", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
        &Calibration::rotation_scale},
       {"translation_scale", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,

@@ -137,6 +137,9 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 //        entering/leaving would move the centroid without any object motion, so t is the mean
 //        displacement of the material points present in both masks (exact while the contact
 //        sticks; zero in a slide, hence off by default);
+//      * if the larger of |Ω_t|, |Ω_{t−1}| exceeds max_mask_area_ratio times the smaller (a
+//        contact forming or vanishing: its centroid jumps with nothing moving, while a sliding
+//        patch keeps its area), the same mean displacement of the common material points;
 //      * otherwise the weighted centroid's displacement (also follows a sliding patch). With
 //        kVelocity this includes a centroid shift from pressing harder on a tilted object, or
 //        from pressure moving within the patch (rolling), which no rule here can tell from a
@@ -170,6 +173,7 @@ class MotionEstimator {
   double c_velocity_ = 0.0;
   double c_displacement_ = 0.0;
   double max_mask_change_ = 0.0;
+  double max_mask_area_ratio_ = 1e4;
   Eigen::Vector3d rotation_scale_ = Eigen::Vector3d::Ones();
   Eigen::Vector3d displacement_rotation_scale_ = Eigen::Vector3d::Ones();  // ⊙ ratio
   Eigen::Vector3d translation_scale_ = Eigen::Vector3d::Ones();
