@@ -10,9 +10,12 @@ of each connected component of the mask, the centroid of the largest component a
 centroid weighted by the contact points' height z, and (with --recording, a simulator recording
 holding sim_labels.csv) the simulator's true patch centroid. With --frames, the same z-weighted
 centroid at each listed frame against the simulator's, with the mask's size and how many of its
-cells lie within --border grid cells of the pad's edge (docs/accuracy.md item 5).
+cells lie within --border grid cells of the pad's edge (docs/accuracy.md item 5). It also prints
+the largest area ratio between consecutive masks (larger cell count over smaller) and how many
+frames exceed --area-ratio (`max_mask_area_ratio`), per simulator phase with --recording.
 
-Usage: mask_centroid.py DIR [--gate 0.3] [--recording REC_DIR] [--frames 72,239 [--border 3]]
+Usage: mask_centroid.py DIR [--gate 0.3] [--area-ratio 1.5] [--recording REC_DIR]
+                        [--frames 72,239 [--border 3]]
 (docs/dsp.md section 4.1)
 """
 import argparse
@@ -43,6 +46,11 @@ def components(cells):
                     stack.append(q)
         found.append(comp)
     return sorted(found, key=len, reverse=True)
+
+
+def sim_phases(recording, pad):
+    with open(os.path.join(recording, "sim_labels.csv"), newline="") as f:
+        return {int(r["index"]): r["phase"] for r in csv.DictReader(f) if r["sensor"] == pad}
 
 
 def sim_centroids(recording, pad):
@@ -90,11 +98,13 @@ def frame_report(folder, pad, recording, frames, border):
         print(line)
 
 
-def pad_report(folder, pad, gate, recording):
+def pad_report(folder, pad, gate, area_bound, recording):
     mask, shape = load_npy(f"{folder}/{pad}/mask.npy")
     points, _ = load_npy(f"{folder}/{pad}/points.npy")
     frames = shape[0]
     truth = sim_centroids(recording, pad) if recording else {}
+    phases = sim_phases(recording, pad) if recording else {}
+    ratios = {}  # phase -> (largest area ratio, frames above area_bound)
 
     def cells_of(n):
         return {i for i in range(CELLS) if mask[n * CELLS + i]}
@@ -113,6 +123,9 @@ def pad_report(folder, pad, gate, recording):
             first = (n, cells, c)
         last = (n, cells, c)
         if prev:
+            ratio = max(len(cells), len(prev)) / min(len(cells), len(prev))
+            top, above = ratios.get(phases.get(n, "all"), (1.0, 0))
+            ratios[phases.get(n, "all")] = (max(top, ratio), above + (ratio > area_bound))
             change = 1.0 - len(cells & prev) / len(cells | prev)
             for k in range(2):
                 all_steps[k] += c[k] - prev_c[k]
@@ -128,6 +141,9 @@ def pad_report(folder, pad, gate, recording):
           f"({all_steps[0]:.3f}, {all_steps[1]:.3f}) mm")
     print(f"{pad}: summed over frames with mask change <= {gate}: "
           f"({kept_steps[0]:.3f}, {kept_steps[1]:.3f}) mm; {over_gate} frame(s) above it")
+    for phase, (top, above) in ratios.items():
+        print(f"{pad}: {phase}: largest area ratio between consecutive masks {top:.2f}, "
+              f"{above} frame(s) above {area_bound}")
     for label, (n, cells, c) in (("first", first), ("last", last)):
         comps = components(cells)
         big = centroid_mm(points, n, comps[0])
@@ -144,6 +160,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("dir", help="tacse3-replay --dump-fields folder")
     ap.add_argument("--gate", type=float, default=0.3, help="max_mask_change to evaluate")
+    ap.add_argument("--area-ratio", type=float, default=1.5,
+                    help="max_mask_area_ratio to count frames against")
     ap.add_argument("--recording", help="the replayed simulator recording (for sim_labels.csv)")
     ap.add_argument("--frames", help="comma-separated frame indices: the centroid at each instead")
     ap.add_argument("--border", type=int, default=3, help="edge band for --frames, grid cells")
@@ -158,7 +176,7 @@ def main():
         if frames is not None:
             frame_report(a.dir, pad, a.recording, frames, a.border)
         else:
-            pad_report(a.dir, pad, a.gate, a.recording)
+            pad_report(a.dir, pad, a.gate, a.area_ratio, a.recording)
 
 
 if __name__ == "__main__":
