@@ -120,8 +120,8 @@ struct Calibration {
   // the material points in both masks, as for max_mask_change. A forming or vanishing contact
   // grows or shrinks by up to 13x in one frame (a flat face is first seen at a corner), and its
   // centroid then jumps by millimetres with nothing moving; a sliding patch keeps its area, cells
-  // entering at the leading edge as others leave the trailing one (at most 1.18x in one frame
-  // on the simulator's 10 mm slides, docs/dsp.md §4.1). [1, 1e4]; 1e4 = off.
+  // entering at the leading edge as others leave the trailing one (at most 1.25x in one frame
+  // on the simulator's slides measured in docs/dsp.md §4.1). [1, 1e4]; 1e4 = off.
   double max_mask_area_ratio = 1.5;
 
   // --- per-axis scales applied to this sensor's estimates, in its own frame. [0, 100]
