@@ -1031,9 +1031,12 @@ void BlockFlow::maybe_switch_keyframe() noexcept {
 // current frame becomes the keyframe, it is matched directly against the tare frame (level-0
 // windows of the tare frame, warm-started from the chained displacement, so no pyramid is
 // needed). Where that direct match is valid and agrees with the chained value within
-// reanchor_tolerance_px, it replaces it: the drift is reset instead of accumulated. Where the
-// appearance has changed too much for a direct match (large deformation, shading), the chained
-// value is kept. Cost: one tare-model build and one level-0 pass, on switch frames only.
+// reanchor_tolerance_px (by default any valid match), it replaces it: the drift is reset instead
+// of accumulated, and so is a chain that took a wrong match (the direct match is measured
+// against the frame every displacement refers to; the chain is the sum of every interval's
+// matches). Where the appearance has changed too much for a direct match (large
+// deformation, shading), the chained value is kept. Cost: one tare-model build and one level-0
+// pass, on switch frames only.
 void BlockFlow::re_anchor() noexcept {
   // What this frame reported stays as it was (held values, valid mask and count). The copies
   // live in member scratch (no large stack frames).

@@ -63,8 +63,12 @@ struct BlockFlowConfig {
   double converged_step_px = 0.1;  // the last step must be below this for a valid point
   // At a keyframe switch, points whose direct match against the tare frame agrees with the
   // chained displacement within this tolerance (working px) take the direct value, which
-  // resets the drift of the chain (see BlockFlow::re_anchor()). 0 disables re-anchoring.
-  double reanchor_tolerance_px = 0.5;
+  // resets the drift of the chain (see BlockFlow::re_anchor()). 0 disables re-anchoring. The
+  // default, the largest allowed, lets every valid direct match replace the chain: a chain can
+  // take a wrong match while the gel springs back after a slide (1.7 working px off on the
+  // simulator's screwdriver handle) and would keep that error for good under a tight tolerance,
+  // which protected the wrong chain against the right direct match (docs/dsp.md, stage 2).
+  double reanchor_tolerance_px = 8.0;
 };
 
 // Validates a config (ranges above, finite values). kBadArgument on failure.
