@@ -362,7 +362,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   out.translation_point_m = out.centroid_m;
   const std::int64_t uni = m.n + prev_count_ - common;
   out.mask_change = uni > 0 ? 1.0 - static_cast<double>(common) / static_cast<double>(uni) : 1.0;
-  // Area ratio, larger cell count over smaller (exact in double: counts ≤ kGridCells).
+  // Area ratio, larger cell count over smaller (exact in double: counts ≤ kGridCount).
   const std::int64_t larger = std::max(m.n, prev_count_), smaller = std::min(m.n, prev_count_);
   const bool area_steady =
       static_cast<double>(larger) <= max_mask_area_ratio_ * static_cast<double>(smaller);

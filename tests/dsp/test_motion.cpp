@@ -476,13 +476,18 @@ TEST(Motion, LargeAreaChangeUsesCommonPointsInsteadOfTheCentroidJump) {
 }
 
 TEST(Motion, AContactFormingAtACornerReadsTheMaterialPointsNotTheCentroidJump) {
-  // A flat face is first seen at one corner (a few cells), and one frame later over its whole
+  // A flat face is first seen at one corner (a few cells), and a frame later over most of its
   // face: the mask's centroid jumps by millimetres while nothing moves (the simulator's textured
-  // cube: 4 cells, then 250, docs/dsp.md §4.1). The area-ratio bound (default 1.5) reads that
-  // frame from the material points in both masks; with the bound off (1e4) the sliding rule
-  // reports the jump as a translation of ~0.4 m/s. A patch that only changes its area by less
-  // than the bound keeps the centroid rule, and the double reference decides the same.
-  for (double bound : {1.5, 1e4}) {
+  // cube: 4 cells, then 54, 101, 177; docs/dsp.md §4.1). The area-ratio bound (default 1.5)
+  // reads that frame from the material points in both masks; with the bound off (1e4) the
+  // sliding rule reports the jump as a translation of ~0.4 m/s. The face then shrinks (pressure
+  // released) by a cell-count ratio just under 1.5, which keeps the centroid rule; at a bound
+  // equal to that ratio still the centroid, just below it the material points. The double
+  // reference decides the same on every frame.
+  struct Chain {
+    SensorMotion corner, face, smaller;
+  };
+  auto run_chain = [](double bound) {
     Calibration cal;
     cal.velocity_proxy = VelocityProxy::kVelocity;
     cal.max_mask_area_ratio = bound;
@@ -490,7 +495,7 @@ TEST(Motion, AContactFormingAtACornerReadsTheMaterialPointsNotTheCentroidJump) {
     corner.contact_centre_G = Eigen::Vector3d(-3e-3, 2e-3, 0.0);
     corner.radius_m = 1.5e-3;
     face.radius_m = 5e-3;
-    smaller_face.radius_m = 4.4e-3;  // area ratio (5 / 4.4)^2 ≈ 1.3 < 1.5
+    smaller_face.radius_m = 3.9e-3;
     const VectorField still;  // zero-initialised: the gel does not move
     Runner run(cal);
     dsp_ref::ContactDetectorRef rdet(cal);
@@ -501,28 +506,45 @@ TEST(Motion, AContactFormingAtACornerReadsTheMaterialPointsNotTheCentroidJump) {
       const SensorMotion m = run.frame(f.fz, still, still);
       std::vector<double> fz(static_cast<std::size_t>(kGridCount));
       for (std::size_t i = 0; i < fz.size(); ++i) fz[i] = from_q<16>(f.fz.v[i]);
-      const dsp_ref::SensorMotionRef r = rme.update(rdet.detect(fz, still, f.valid), zero, zero, kDt);
+      const dsp_ref::SensorMotionRef r =
+          rme.update(rdet.detect(fz, still, f.valid), zero, zero, kDt);
+      EXPECT_EQ(r.points, m.points);
       EXPECT_EQ(m.translation_source, static_cast<TranslationSource>(r.translation_source));
-      // The weighted centroid's heights go through the Q16 filter (≈ 4 nm per frame, 0.5 µm/s).
+      // Positions are rounded to 0.5 nm and the heights that weight the centroid go through
+      // the Q16 filter: ≈ 4 nm per frame on a patch at rest (0.5 µm/s), ≈ 41 nm on the jump
+      // frame, where the weights themselves change (1e-5 of its 0.43 m/s).
       EXPECT_LT((m.translation - r.translation).norm(), 1e-6 + 2e-5 * r.translation.norm());
       return m;
     };
-    const SensorMotion m0 = both(corner);
-    const SensorMotion m1 = both(face);
-    ASSERT_GT(m1.points, 1.5 * m0.points);
-    ASSERT_TRUE(m1.translation_valid);
+    Chain c;
+    c.corner = both(corner);
+    c.face = both(face);
+    c.smaller = both(smaller_face);
+    return c;
+  };
+  for (double bound : {1.5, 1e4}) {
+    const Chain c = run_chain(bound);
+    ASSERT_GT(c.face.points, 1.5 * c.corner.points);
+    ASSERT_TRUE(c.face.translation_valid);
     if (bound == 1.5) {
-      EXPECT_EQ(m1.translation_source, TranslationSource::kCommonPoints);
-      EXPECT_LT(m1.translation.norm(), 1e-6);
+      EXPECT_EQ(c.face.translation_source, TranslationSource::kCommonPoints);
+      EXPECT_LT(c.face.translation.norm(), 1e-6);
     } else {
-      EXPECT_EQ(m1.translation_source, TranslationSource::kCentroid);
-      EXPECT_GT(m1.translation.norm(), 0.2);
+      EXPECT_EQ(c.face.translation_source, TranslationSource::kCentroid);
+      EXPECT_GT(c.face.translation.norm(), 0.2);
     }
-    // The face shrinks a little (pressure released): within the bound, the centroid rule.
-    const SensorMotion m2 = both(smaller_face);
-    ASSERT_LT(m1.points, 1.5 * m2.points);
-    EXPECT_EQ(m2.translation_source, TranslationSource::kCentroid) << bound;
   }
+  const Chain c = run_chain(1.5);
+  const double ratio = static_cast<double>(c.face.points) / static_cast<double>(c.smaller.points);
+  std::printf("corner %d cells, face %d, smaller face %d: ratio %.4f\n", c.corner.points,
+              c.face.points, c.smaller.points, ratio);
+  ASSERT_GT(ratio, 1.3);  // a real shrink, close to the bound
+  ASSERT_LT(ratio, 1.5);
+  EXPECT_EQ(c.smaller.translation_source, TranslationSource::kCentroid);
+  // The bound is inclusive: a ratio equal to it reads the centroid, one above it does not.
+  EXPECT_EQ(run_chain(ratio).smaller.translation_source, TranslationSource::kCentroid);
+  EXPECT_EQ(run_chain(std::nextafter(ratio, 1.0)).smaller.translation_source,
+            TranslationSource::kCommonPoints);
 }
 
 TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
@@ -588,7 +610,7 @@ TEST(Motion, SlidingCentroidIsWeightedByHeightSoAHysteresisTrailHardlyMovesIt) {
   Calibration cal;
   cal.velocity_proxy = VelocityProxy::kVelocity;
   // The one-frame 6 mm step with its trail doubles Ω's area, which the area-ratio bound would
-  // read as a contact forming (previous test); this test isolates the weighting.
+  // read as a contact forming (AContactFormingAtACorner… above); this test isolates the weighting.
   cal.max_mask_area_ratio = 1e4;
   RigidContactScene before, after;
   before.contact_centre_G = Eigen::Vector3d(-3e-3, 0.0, 0.0);

@@ -123,9 +123,11 @@ def pad_report(folder, pad, gate, area_bound, recording):
             first = (n, cells, c)
         last = (n, cells, c)
         if prev:
-            ratio = max(len(cells), len(prev)) / min(len(cells), len(prev))
-            top, above = ratios.get(phases.get(n, "all"), (1.0, 0))
-            ratios[phases.get(n, "all")] = (max(top, ratio), above + (ratio > area_bound))
+            if cells & prev:  # the rule reads no translation when the masks share no cell
+                ratio = max(len(cells), len(prev)) / min(len(cells), len(prev))
+                phase = phases.get(n, "unlabelled") if recording else "all frames"
+                top, above = ratios.get(phase, (1.0, 0))
+                ratios[phase] = (max(top, ratio), above + (ratio > area_bound))
             change = 1.0 - len(cells & prev) / len(cells | prev)
             for k in range(2):
                 all_steps[k] += c[k] - prev_c[k]

@@ -117,11 +117,13 @@ struct Calibration {
   double max_mask_change = 1.0;
   // If the mask's area changes by more than this factor between frames (the larger cell count
   // over the smaller), the sliding rule's centroid step is replaced by the mean displacement of
-  // the material points in both masks, as for max_mask_change. A forming or vanishing contact
-  // grows or shrinks by up to 13x in one frame (a flat face is first seen at a corner), and its
-  // centroid then jumps by millimetres with nothing moving; a sliding patch keeps its area, cells
-  // entering at the leading edge as others leave the trailing one (at most 1.25x in one frame
-  // on the simulator's slides measured in docs/dsp.md §4.1). [1, 1e4]; 1e4 = off.
+  // the material points in both masks, as for max_mask_change. A forming contact grows by up to
+  // 13.5x in one frame (a flat face is first seen at a corner), and its centroid then jumps by
+  // millimetres with nothing moving; a sliding patch keeps its area, cells entering at the
+  // leading edge as others leave the trailing one (at most 1.25x in one frame on the
+  // simulator's slides measured in docs/dsp.md §4.1, a margin of 1.2x). The rule is
+  // symmetric, so a contact vanishing as fast is read the same way (not measured: the
+  // recordings end in a hold). [1, 1e4], inclusive; 1e4 = off.
   double max_mask_area_ratio = 1.5;
 
   // --- per-axis scales applied to this sensor's estimates, in its own frame. [0, 100]
