@@ -541,7 +541,9 @@ TEST(Motion, AContactFormingAtACornerReadsTheMaterialPointsNotTheCentroidJump) {
   ASSERT_GT(ratio, 1.3);  // a real shrink, close to the bound
   ASSERT_LT(ratio, 1.5);
   EXPECT_EQ(c.smaller.translation_source, TranslationSource::kCentroid);
-  // The bound is inclusive: a ratio equal to it reads the centroid, one above it does not.
+  // The bound is inclusive: a ratio equal to it reads the centroid, one above it does not. Both
+  // implementations test larger <= bound * smaller, so the ratio must round-trip exactly.
+  ASSERT_EQ(ratio * static_cast<double>(c.smaller.points), static_cast<double>(c.face.points));
   EXPECT_EQ(run_chain(ratio).smaller.translation_source, TranslationSource::kCentroid);
   EXPECT_EQ(run_chain(std::nextafter(ratio, 1.0)).smaller.translation_source,
             TranslationSource::kCommonPoints);

@@ -68,6 +68,9 @@ struct BlockFlowConfig {
   // take a wrong match while the gel springs back after a slide (1.7 working px off on the
   // simulator's screwdriver handle) and would keep that error for good under a tight tolerance,
   // which protected the wrong chain against the right direct match (docs/dsp.md, stage 2).
+  // "Every" holds because with the default iterations a match moves at most about 6 px from its
+  // warm start (4 steps of at most max_step_px per component); more or longer steps could
+  // exceed the tolerance.
   double reanchor_tolerance_px = 8.0;
 };
 
