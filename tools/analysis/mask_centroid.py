@@ -48,19 +48,16 @@ def components(cells):
     return sorted(found, key=len, reverse=True)
 
 
-def sim_phases(recording, pad):
+def sim_labels(recording, pad):
+    """The simulator's per-frame patch centroid (mm) and phase for one pad, from sim_labels.csv."""
+    centroids, phases = {}, {}
     with open(os.path.join(recording, "sim_labels.csv"), newline="") as f:
-        return {int(r["index"]): r["phase"] for r in csv.DictReader(f) if r["sensor"] == pad}
-
-
-def sim_centroids(recording, pad):
-    path = os.path.join(recording, "sim_labels.csv")
-    out = {}
-    with open(path, newline="") as f:
         for row in csv.DictReader(f):
             if row["sensor"] == pad:
-                out[int(row["index"])] = (float(row["centroid_u_mm"]), float(row["centroid_v_mm"]))
-    return out
+                n = int(row["index"])
+                centroids[n] = (float(row["centroid_u_mm"]), float(row["centroid_v_mm"]))
+                phases[n] = row["phase"]
+    return centroids, phases
 
 
 def centroid_mm(points, n, cells, weighted=False):
@@ -77,7 +74,7 @@ def frame_report(folder, pad, recording, frames, border):
     """Per listed frame: the z-weighted mask centroid against the simulator's patch centroid."""
     mask, shape = load_npy(f"{folder}/{pad}/mask.npy")
     points, _ = load_npy(f"{folder}/{pad}/points.npy")
-    truth = sim_centroids(recording, pad) if recording else {}
+    truth = sim_labels(recording, pad)[0] if recording else {}
     for n in frames:
         if not 0 <= n < shape[0]:
             print(f"{pad}: frame {n} is not in the dump ({shape[0]} frames)")
@@ -102,8 +99,7 @@ def pad_report(folder, pad, gate, area_bound, recording):
     mask, shape = load_npy(f"{folder}/{pad}/mask.npy")
     points, _ = load_npy(f"{folder}/{pad}/points.npy")
     frames = shape[0]
-    truth = sim_centroids(recording, pad) if recording else {}
-    phases = sim_phases(recording, pad) if recording else {}
+    truth, phases = sim_labels(recording, pad) if recording else ({}, {})
     ratios = {}  # phase -> (largest area ratio, frames above area_bound)
 
     def cells_of(n):
@@ -123,12 +119,13 @@ def pad_report(folder, pad, gate, area_bound, recording):
             first = (n, cells, c)
         last = (n, cells, c)
         if prev:
-            if cells & prev:  # the rule reads no translation when the masks share no cell
+            common = len(cells & prev)
+            if common:  # the rule reads no translation when the masks share no cell
                 ratio = max(len(cells), len(prev)) / min(len(cells), len(prev))
                 phase = phases.get(n, "unlabelled") if recording else "all frames"
                 top, above = ratios.get(phase, (1.0, 0))
                 ratios[phase] = (max(top, ratio), above + (ratio > area_bound))
-            change = 1.0 - len(cells & prev) / len(cells | prev)
+            change = 1.0 - common / len(cells | prev)
             for k in range(2):
                 all_steps[k] += c[k] - prev_c[k]
                 if change <= gate:
