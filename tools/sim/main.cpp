@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
   cfg.scenario.settle_s = o.settle_s;
   cfg.scenario.motion_s = o.motion_s;
   cfg.scenario.hold_s = o.hold_s;
+  cfg.scenario.release_s = o.release_s;
   cfg.scenario.fps = o.fps;
   if (!std::isnan(o.radius)) cfg.scenario.object.size_mm = o.radius;
   if (!std::isnan(o.friction)) cfg.scenario.object.friction = o.friction;

@@ -25,6 +25,7 @@ struct Options {
   double friction = NAN;
   std::vector<double> offset;
   double approach_s = 0.1, grasp_s = 0.4, settle_s = 0.1, motion_s = 0.0, hold_s = 0.4;
+  double release_s = 0.0;
   double fps = 120.0;
   std::string sensors = "both";
   std::string colour = "rgb";

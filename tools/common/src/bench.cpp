@@ -38,6 +38,10 @@ std::string SimCase::sim_arguments() const {
                   approach_s, grasp_s, settle_s, hold_s);
     s += buf;
   }
+  if (release_s > 0.0) {
+    std::snprintf(buf, sizeof(buf), " --release-s %g", release_s);
+    s += buf;
+  }
   return s;
 }
 
@@ -55,6 +59,7 @@ std::string make_sim_config(const SimCase& c, sim::SimConfig* out) {
   cfg.scenario.grasp_s = c.grasp_s;
   cfg.scenario.settle_s = c.settle_s;
   cfg.scenario.hold_s = c.hold_s;
+  cfg.scenario.release_s = c.release_s;
   if (c.radius_mm > 0.0) cfg.scenario.object.size_mm = c.radius_mm;
   if (std::string e = sim::validate(cfg); !e.empty()) return c.label() + ": " + e;
   *out = cfg;
