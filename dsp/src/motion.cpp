@@ -160,6 +160,7 @@ Status MotionEstimator::configure(const Calibration& cal) noexcept {
   c_displacement_ = cal.c_displacement;
   max_mask_change_ = cal.max_mask_change;
   max_mask_area_ratio_ = cal.max_mask_area_ratio;
+  release_load_rate_ = cal.release_load_rate;
   rotation_scale_ =
       Eigen::Vector3d(cal.rotation_scale[0], cal.rotation_scale[1], cal.rotation_scale[2]);
   displacement_rotation_scale_ = rotation_scale_.cwiseProduct(
@@ -207,6 +208,10 @@ void MotionEstimator::reset() noexcept {
   prev_shear_.x.fill(0);
   prev_shear_.y.fill(0);
   have_prev_shear_ = false;
+  load_ = 0.0;
+  load_change_ = 0.0;
+  prev_load_ = 0.0;
+  have_load_ = false;
   reset_detector();
 }
 
@@ -273,6 +278,28 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   ContactMoments mi = m_stayed;
   sum_increment.store(mi);
 
+  // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
+  // smoothed exponentially like X, and ρ_L = −(smoothed L_t − L_{t−1}) / (smoothed L · Δt), its
+  // relative rate of fall. When the pads open, the contact loses its load and the gel it lets go
+  // of springs back: the shear's rigid content relaxes about as fast as the load falls (cylinder
+  // ry 2° held, then released over 0.3 s: ρ 5.4/s against ρ_L 3.7/s at the frame the detector
+  // used to call a slip, 9.1/s against 6.5/s at the next), and the displacement proxy reads the
+  // spring-back as the object moving back. A grasp holds its load: ρ_L ≤ 2.7/s during the
+  // simulator's stick motions, ≤ 4.8/s in its slides, peaks of 6.5–24.5/s while a contact is
+  // released over 0.3 s (docs/dsp.md §4.2b).
+  if (m.n > 0) {
+    const double alpha = content_alpha(dt_s, smoothing_s_);
+    const double load = static_cast<double>(m.sz);
+    load_change_ = have_load_ ? load_change_ + alpha * ((load - prev_load_) - load_change_) : 0.0;
+    load_ = have_load_ ? load_ + alpha * (load - load_) : load;
+    prev_load_ = load;
+    have_load_ = true;
+    out.load_drop_rate = load_ > 0.0 ? -load_change_ / (load_ * dt_s) : 0.0;
+  } else {
+    have_load_ = false;
+  }
+  const bool unloading_fast = out.load_drop_rate > release_load_rate_;
+
   // --- kAuto: the stick/slip detector on the rigid-body content of the shear and its increment.
   // The proxy of this frame is the one decided up to the previous frame.
   const bool sticking = automatic ? !slipping_ : mode_ == VelocityProxy::kDisplacement;
@@ -300,8 +327,11 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       out.slip_relax_rate = x2 > 0.0 ? -content_.dot(change) / (x2 * dt_s) : 0.0;
       const bool rest = out.shear_rate_m_s < rest_speed_;
       if (!slipping_) {
+        // Only relaxation beyond the load's own relative fall counts, and none while the load
+        // falls faster than release_load_rate (a release, below).
         const bool relaxing =
-            out.shear_shift_m > min_shift_m_ && out.slip_relax_rate > relax_rate_on_;
+            out.shear_shift_m > min_shift_m_ && !unloading_fast &&
+            out.slip_relax_rate - std::max(0.0, out.load_drop_rate) > relax_rate_on_;
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
         rest_s_ = rest ? rest_s_ + dt_s : 0.0;
         // Unloaded (|X| ≤ slip_min_shift_m, the least shift an onset needs): any slide it could be
@@ -336,7 +366,11 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // Final proxy of this frame, and (kAuto while sticking) the velocity proxy's reading beside it.
   out.velocity_differs = automatic && sticking;
   out.moments = sticking ? mi : mv;
-  out.proxy_valid = !sticking || have_prev_shear_;
+  // A sticking contact whose load falls faster than release_load_rate is being let go: the
+  // displacement proxy's increments are the gel springing back, not the object, so this frame's
+  // chosen reading is dropped (rotation and translation; the velocity reading beside it stays).
+  out.releasing = sticking && out.contact && unloading_fast;
+  out.proxy_valid = (!sticking || have_prev_shear_) && !out.releasing;
   out.proxy_scale = sticking ? displacement_scale : velocity_scale;
   out.rotation_scale = sticking ? displacement_rotation_scale_ : rotation_scale_;
 
@@ -414,6 +448,11 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       out.translation_valid = true;
       if (slide_source == TranslationSource::kCentroid) out.translation_point_m = slide_point;
     }
+    if (out.releasing) {
+      disp.setZero();
+      out.translation_valid = false;
+      out.translation_source = TranslationSource::kNone;
+    }
     out.translation =
         translation_scale_.cwiseProduct(Eigen::Vector3d(disp.x(), disp.y(), 0.0) / dt_s);
     if (out.velocity_differs && slide_source != TranslationSource::kNone) {
@@ -437,7 +476,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     result = solve3(AtA, Atb, opt);
     return Eigen::Vector3d(axis_scale.cwiseProduct(result.x));
   };
-  if (out.moments.n > 0) {
+  if (out.moments.n > 0 && !out.releasing) {
     out.omega = solve_rotation(out.moments, out.proxy_scale, out.rotation_scale, out.solve);
     out.rotation_valid = out.proxy_valid && out.solve.valid;
   }

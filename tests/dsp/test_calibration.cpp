@@ -58,6 +58,7 @@ std::vector<BadCase> bad_cases() {
   add("c_displacement inf", [](Calibration& c) { c.c_displacement = kInf; });
   add("mask change NaN", [](Calibration& c) { c.max_mask_change = kNan; });
   add("area ratio NaN", [](Calibration& c) { c.max_mask_area_ratio = kNan; });
+  add("release rate NaN", [](Calibration& c) { c.release_load_rate = kNan; });
   add("rot scale NaN", [](Calibration& c) { c.rotation_scale[1] = kNan; });
   add("trans scale inf", [](Calibration& c) { c.translation_scale[2] = kInf; });
   add("lambda NaN", [](Calibration& c) { c.solve_lambda_rel = kNan; });
@@ -86,6 +87,8 @@ std::vector<BadCase> bad_cases() {
   add("mask change 1.5", [](Calibration& c) { c.max_mask_change = 1.5; });
   add("area ratio below 1", [](Calibration& c) { c.max_mask_area_ratio = 0.99; });
   add("area ratio 1e5", [](Calibration& c) { c.max_mask_area_ratio = 1e5; });
+  add("release rate zero", [](Calibration& c) { c.release_load_rate = 0.0; });
+  add("release rate 1e5", [](Calibration& c) { c.release_load_rate = 1e5; });
   add("scale 1000", [](Calibration& c) { c.translation_scale[0] = 1000.0; });
   add("L = 0", [](Calibration& c) { c.moving_average_length = 0; });
   add("L > max", [](Calibration& c) { c.moving_average_length = kMaxMovingAverage + 1; });
@@ -112,6 +115,10 @@ TEST(Calibration, RangeBoundsAreInclusiveWhereDocumented) {
   c.max_mask_area_ratio = 1.0;  // every area change reads the material points, allowed
   EXPECT_EQ(validate(c), Status::kOk);
   c.max_mask_area_ratio = 1e4;  // off
+  EXPECT_EQ(validate(c), Status::kOk);
+  c.release_load_rate = 1e4;  // off
+  EXPECT_EQ(validate(c), Status::kOk);
+  c.release_load_rate = 1e-3;  // (0, 1e4]: any positive rate
   EXPECT_EQ(validate(c), Status::kOk);
 }
 

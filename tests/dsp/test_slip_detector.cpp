@@ -2,6 +2,7 @@
 // tacse3 tests: VelocityProxy::kAuto: planar rigid content, stick/slip decisions, deficit payback.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -24,7 +25,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 struct Disc {
   std::unique_ptr<ContactSet> cs = std::make_unique<ContactSet>();
   dsp_ref::ContactSetRef ref;
-  explicit Disc(double radius_cells = 6.0) {
+  explicit Disc(double radius_cells = 6.0, double depth_m = 0.5e-3) {
     const auto n = static_cast<std::size_t>(kGridCount);
     ref.mask.assign(n, 0);
     ref.fz_filtered.assign(n, 0.0);
@@ -40,14 +41,15 @@ struct Disc {
         cs->mask.v[i] = 1;
         cs->x_nm.v[i] = xn;
         cs->y_nm.v[i] = yn;
-        cs->z_nm.v[i] = 500000;
+        const auto zn = static_cast<std::int32_t>(std::lround(depth_m * 1e9));
+        cs->z_nm.v[i] = zn;
         ++cs->count;
         ref.mask[i] = 1;
-        ref.q[i] = Eigen::Vector3d(xn * 1e-9, yn * 1e-9, 0.5e-3);
+        ref.q[i] = Eigen::Vector3d(xn * 1e-9, yn * 1e-9, zn * 1e-9);
         ++ref.count;
       }
     }
-    cs->contact = true;
+    cs->contact = cs->count > 0;
   }
   // Shear (shear units) of a rotation by theta about the pad normal plus a shift (m), read as a
   // contact displacement with c_displacement.
@@ -410,6 +412,89 @@ TEST(SlipDetector, ContactLossRestartsSticking) {
   EXPECT_FALSE(m.contact);
   ASSERT_EQ(me->update(*disc.cs, *sh, kDt, m), Status::kOk);
   EXPECT_FALSE(m.slipping);
+}
+
+// A stuck contact let go. A 2° stick rotation is held for 0.3 s, then the pads open over 0.3 s
+// (minimum jerk): the depth d falls to 0, the patch radius with √d (a sphere), and the gel under
+// what is left springs back with the load, shear ∝ d. The object does not move. The shear's
+// rigid content then relaxes (ρ ≈ 1.5 ρ_d) while the load Σ z ∝ d² falls faster (ρ_L = 2 ρ_d):
+//  - no slip onset (only relaxation beyond the load's fall counts), so the velocity proxy's
+//    reading of the held shear (the deficit, ≈ 12° here) is never paid;
+//  - the frames whose load falls faster than release_load_rate drop the displacement proxy's
+//    reading of the spring-back, so the pose stays near 2° (with the rule off it reads most of
+//    the way back to 0°);
+//  - the same in kDisplacement, never in kVelocity (no chosen reading of increments);
+//  - the reference decides every frame the same and integrates the same rotation.
+TEST(SlipDetector, AReleasedStuckContactIsNeitherASlipNorAMotionBack) {
+  constexpr int kRest = 12, kRamp = 36, kHold = 36, kRelease = 36, kAfter = 12;
+  const double theta_end = 2.0 * kDeg;
+  std::vector<std::unique_ptr<Disc>> discs;
+  std::vector<double> theta;
+  for (int k = 0; k < kRest + kRamp + kHold; ++k) {
+    discs.push_back(std::make_unique<Disc>());
+    theta.push_back(k < kRest ? 0.0 : theta_end * min_jerk((k - kRest) / double(kRamp)));
+  }
+  double min_rate_while_releasing = 1e9;
+  for (int k = 1; k <= kRelease + kAfter; ++k) {
+    const double depth = 1.0 - min_jerk(k / double(kRelease));  // relative to 0.5 mm
+    discs.push_back(std::make_unique<Disc>(6.0 * std::sqrt(depth), 0.5e-3 * depth));
+    theta.push_back(theta_end * depth);
+  }
+  ASSERT_FALSE(discs.back()->cs->contact);
+  struct Run {
+    double rotation = 0.0, rotation_ref = 0.0;
+    int onsets = 0, releasing = 0, mismatches = 0;
+  };
+  auto replay = [&](VelocityProxy mode, double release_load_rate) {
+    Calibration cal = auto_cal();
+    cal.velocity_proxy = mode;
+    cal.release_load_rate = release_load_rate;
+    auto est = std::make_unique<MotionEstimator>();
+    EXPECT_EQ(est->configure(cal), Status::kOk);
+    dsp_ref::MotionRef ref(cal);
+    SlipPayback payback;
+    payback.configure(cal.slip_catchup_frames);
+    dsp_ref::SlipPaybackRef payback_ref(cal.slip_catchup_frames);
+    auto sh = std::make_unique<VectorField>();
+    std::vector<double> sx, sy;
+    Run r;
+    for (std::size_t k = 0; k < theta.size(); ++k) {
+      discs[k]->shear(theta[k], 0.0, cal.c_displacement, *sh, sx, sy);
+      SensorMotion m;
+      EXPECT_EQ(est->update(*discs[k]->cs, *sh, kDt, m), Status::kOk);
+      const dsp_ref::SensorMotionRef mr = ref.update(discs[k]->ref, sx, sy, kDt);
+      r.rotation += pay(payback, m).z() * kDt;
+      r.rotation_ref += pay(payback_ref, mr).z() * kDt;
+      r.onsets += m.slip_onset ? 1 : 0;
+      r.onsets += mr.slip_onset ? 1 : 0;
+      r.releasing += m.releasing ? 1 : 0;
+      if (m.releasing) {
+        min_rate_while_releasing = std::min(min_rate_while_releasing, m.load_drop_rate);
+        EXPECT_FALSE(m.proxy_valid) << "frame " << k;
+        EXPECT_FALSE(m.translation_valid) << "frame " << k;
+      }
+      r.mismatches += (m.releasing != mr.releasing || m.slipping != mr.slipping) ? 1 : 0;
+    }
+    return r;
+  };
+  const double rate = Calibration{}.release_load_rate;
+  const Run on = replay(VelocityProxy::kAuto, rate);
+  const Run off = replay(VelocityProxy::kAuto, 1e4);
+  const Run disp = replay(VelocityProxy::kDisplacement, rate);
+  const Run vel = replay(VelocityProxy::kVelocity, rate);
+  EXPECT_EQ(on.onsets, 0);
+  EXPECT_EQ(off.onsets, 0);
+  EXPECT_GT(on.releasing, 10);
+  EXPECT_GT(min_rate_while_releasing, rate);
+  EXPECT_EQ(off.releasing, 0);
+  EXPECT_EQ(vel.releasing, 0);
+  EXPECT_EQ(on.mismatches + disp.mismatches + vel.mismatches, 0);
+  // With the rule the pose keeps most of the 2°; without it, the spring-back reads most of the
+  // way back to 0°.
+  EXPECT_NEAR(on.rotation, theta_end, 0.3 * kDeg);
+  EXPECT_NEAR(on.rotation_ref, on.rotation, 0.01 * kDeg);
+  EXPECT_NEAR(disp.rotation, on.rotation, 0.01 * kDeg);
+  EXPECT_LT(off.rotation, theta_end - 1.0 * kDeg);
 }
 
 // The decision-locked reference (dsp_ref::SlipDecision, used only to report a second fixed−ref

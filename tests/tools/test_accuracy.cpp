@@ -411,4 +411,35 @@ TEST(Accuracy, AChainThatTookAWrongMatchIsReanchoredToTheTare) {
   }
 }
 
+// A grasp released at the end: after the hold the pads open over 0.3 s and the contact vanishes;
+// the object stays where the motion left it. The stuck gel springs back as it is let go, which
+// the displacement proxy read as the object moving back (sphere rx 2°: 1.43° off at the end,
+// most of the motion undone; ty 0.5 mm: 0.36 mm), and its relaxation started a slip whose
+// payback added the velocity proxy's reading of the held shear (31° off). The detector now
+// counts only relaxation beyond the load's own fall, and frames whose load Σ z falls faster
+// than release_load_rate drop the displacement reading (docs/dsp.md §4.2b). Defaults, committed
+// calibration.
+TEST(Accuracy, AReleasedGraspKeepsThePoseItHeld) {
+  const tacse3::config::CalibrationSet committed = committed_calibration();
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  tacse3::config::CalibrationSet no_gate = committed;
+  for (auto& s : no_gate.sensor) s.release_load_rate = 1e4;
+  tt::SimCase rx = sim_case("sphere", "rx", 2.0, 3, 0.0);
+  rx.release_s = 0.3;
+  tt::SimCase ty = sim_case("sphere", "ty", 0.5, 3, 0.0);
+  ty.release_s = 0.3;
+  const tt::PoseErrors rx_on = replay_errors(rx, committed);
+  const tt::PoseErrors rx_off = replay_errors(rx, no_gate);
+  const tt::PoseErrors ty_on = replay_errors(ty, committed);
+  std::printf("%s: rotation %.2f deg for 2, error %.2f deg (%.2f without the release rule)\n",
+              rx.sim_arguments().c_str(), rx_on.estimated_rotation_deg,
+              rx_on.final_rotation_error_deg, rx_off.final_rotation_error_deg);
+  std::printf("%s: translation %.2f mm for 0.5, error %.2f mm\n", ty.sim_arguments().c_str(),
+              ty_on.estimated_translation_mm, ty_on.final_translation_error_mm);
+  EXPECT_LT(rx_on.final_rotation_error_deg, 0.5);
+  EXPECT_GT(rx_off.final_rotation_error_deg, 1.0);
+  EXPECT_LT(ty_on.final_translation_error_mm, 0.2);
+  EXPECT_LT(ty_on.final_rotation_error_deg, 0.5);
+}
+
 }  // namespace

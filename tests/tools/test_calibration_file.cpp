@@ -58,6 +58,7 @@ cfg::CalibrationSet odd_set() {
   s.sensor[1].slip_on_frames = 6;
   s.sensor[1].stick_confirm_s = 0.75;
   s.sensor[1].max_mask_area_ratio = 2.25;
+  s.sensor[1].release_load_rate = 6.5;
   s.paper[0].rotation_scale = {0.03, 0.025, 1.2};
   s.paper[1].rotation_scale = {0.03, 0.025, 1.2};
   s.paper[1].translation_scale = {1.5, 1.0, 1.0};
@@ -92,6 +93,7 @@ void expect_same(const dsp::Calibration& a, const dsp::Calibration& b) {
   EXPECT_EQ(a.stick_confirm_s, b.stick_confirm_s);
   EXPECT_EQ(a.slip_catchup_frames, b.slip_catchup_frames);
   EXPECT_EQ(a.slip_smoothing_s, b.slip_smoothing_s);
+  EXPECT_EQ(a.release_load_rate, b.release_load_rate);
   EXPECT_EQ(a.max_mask_change, b.max_mask_change);
   EXPECT_EQ(a.max_mask_area_ratio, b.max_mask_area_ratio);
   EXPECT_EQ(a.rotation_scale, b.rotation_scale);
@@ -133,7 +135,7 @@ TEST(CalibrationFile, RoundTripIsExact) {
   EXPECT_NE(text.find("[sensor]\npixel_pitch_m = 1e-04\n"), std::string::npos) << text;
   EXPECT_NE(text.find("[right]\nvelocity_proxy = \"auto\"\nc_velocity = 0.0081\n"
                       "slip_relax_rate_on = 2.5\nslip_on_frames = 6\nstick_confirm_s = 0.75\n"
-                      "max_mask_area_ratio = 2.25\ntranslation_scale = [1.1, 0.9, 1.0]"),
+                      "release_load_rate = 6.5\nmax_mask_area_ratio = 2.25\ntranslation_scale = [1.1, 0.9, 1.0]"),
             std::string::npos)
       << text;
   EXPECT_NE(text.find("velocity_proxy = \"displacement\""), std::string::npos);
@@ -224,6 +226,8 @@ TEST(CalibrationFile, ValuesAreValidatedNamingTheKey) {
   expect_error(kHead + "[sensor]\nmoving_average_length = 33\n",
                {"\"sensor.moving_average_length\"", "[1, 32]"});
   expect_error(kHead + "[sensor]\nsolve_rcond_min = 1\n", {"\"sensor.solve_rcond_min\"", "1.0)"});
+  expect_error(kHead + "[left]\nrelease_load_rate = 0\n",
+               {"\"left.release_load_rate\" must be in (0.0, 10000.0], got 0.0"});
   expect_error(kHead + "[sensor]\nrotation_scale = [1, 1]\n",
                {"\"sensor.rotation_scale\" must have 3 elements"});
   expect_error(kHead + "[sensor]\nrotation_scale = [1, -1, 1]\n",
@@ -287,7 +291,7 @@ TEST(CalibrationFile, EveryPrefixAndByteFlipFailsCleanly) {
 TEST(CalibrationFile, EveryCalibrationFieldHasAKey) {
   // If dsp::Calibration gains a field, the file must learn it (this list is the file's).
   const auto keys = cfg::sensor_keys();
-  EXPECT_EQ(keys.size(), 32u);
+  EXPECT_EQ(keys.size(), 33u);
   EXPECT_EQ(keys.front(), "pixel_pitch_m");
   EXPECT_EQ(std::count(keys.begin(), keys.end(), "velocity_proxy"), 1);
   // The eight thresholds of the stick/slip detector (VelocityProxy::kAuto).

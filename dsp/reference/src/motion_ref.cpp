@@ -90,6 +90,8 @@ void MotionRef::reset() {
   prev_sx_.assign(n, 0.0);
   prev_sy_.assign(n, 0.0);
   have_prev_shear_ = false;
+  load_ = load_change_ = prev_load_ = 0.0;
+  have_load_ = false;
   reset_detector();
 }
 
@@ -158,6 +160,19 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     return solve_stacked(sys, cal_.solve_lambda_rel * AtA.trace() / 3.0 + lambda_floor);
   };
 
+  // Normal load Σ z over Ω, smoothed like X, and its relative rate of fall ρ_L (every mode).
+  if (out.points > 0) {
+    const double alpha = cal_.slip_smoothing_s > 0.0 ? dt / (cal_.slip_smoothing_s + dt) : 1.0;
+    load_change_ = have_load_ ? load_change_ + alpha * ((z_now - prev_load_) - load_change_) : 0.0;
+    load_ = have_load_ ? load_ + alpha * (z_now - load_) : z_now;
+    prev_load_ = z_now;
+    have_load_ = true;
+    out.load_drop_rate = load_ > 0.0 ? -load_change_ / (load_ * dt) : 0.0;
+  } else {
+    have_load_ = false;
+  }
+  const bool unloading_fast = out.load_drop_rate > cal_.release_load_rate;
+
   const bool sticking =
       automatic ? !slipping_ : cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
   if (automatic) {
@@ -202,8 +217,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
         out.slip_onset = follow->slip_onset;
         if (!slipping_ && follow->stick_confirmed) out.stick_confirmed = true;
       } else if (!slipping_) {
-        const bool relaxing = out.shear_shift_m > cal_.slip_min_shift_m &&
-                              out.slip_relax_rate > cal_.slip_relax_rate_on;
+        const bool relaxing =
+            out.shear_shift_m > cal_.slip_min_shift_m && !unloading_fast &&
+            out.slip_relax_rate - std::max(0.0, out.load_drop_rate) > cal_.slip_relax_rate_on;
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
         rest_s_ = rest ? rest_s_ + dt : 0.0;
         // Unloaded (|X| ≤ slip_min_shift_m) and at rest for slip_on_frames frames: stuck.
@@ -225,7 +241,11 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     }
     out.slipping = !sticking;
   }
-  out.proxy_valid = !sticking || have_prev_shear_;
+  // A sticking contact losing its load faster than release_load_rate is being let go: its
+  // chosen reading is dropped (dsp::MotionEstimator's rule; the followed decision if given).
+  out.releasing = follow != nullptr ? follow->releasing
+                                    : sticking && out.points > 0 && unloading_fast;
+  out.proxy_valid = (!sticking || have_prev_shear_) && !out.releasing;
   out.velocity_differs = automatic && sticking;
   for (auto& p : shear_pts) p.v *= cal_.c_velocity;
   if (sticking) {
@@ -280,6 +300,11 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       out.translation_valid = true;
       if (slide_source == 1) out.translation_point = slide_point;
     }
+    if (out.releasing) {
+      d.setZero();
+      out.translation_valid = false;
+      out.translation_source = 0;
+    }
     d.z() = 0.0;
     out.translation = tscale.cwiseProduct(d / dt);
     if (out.velocity_differs && slide_source != 0) {
@@ -289,7 +314,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       out.velocity_translation_point = slide_source == 1 ? slide_point : out.centroid;
     }
   }
-  if (!out.samples.empty()) out.omega = out.rotation_scale.cwiseProduct(solve(out.samples));
+  if (!out.samples.empty() && !out.releasing) {
+    out.omega = out.rotation_scale.cwiseProduct(solve(out.samples));
+  }
   if (out.velocity_differs) {
     out.velocity_samples = shear_pts;
     out.velocity_rotation_scale = wscale;

@@ -77,6 +77,7 @@ const std::vector<Field>& fields() {
       {"slip_catchup_frames", Field::kInt, 1, 1000, false, false, nullptr,
        &Calibration::slip_catchup_frames},
       {"slip_smoothing_s", Field::kReal, 0.0, 1.0, false, false, &Calibration::slip_smoothing_s},
+      {"release_load_rate", Field::kReal, 0.0, 1e4, true, false, &Calibration::release_load_rate},
       {"max_mask_change", Field::kReal, 0.0, 1.0, false, false, &Calibration::max_mask_change},
       {"max_mask_area_ratio", Field::kReal, 1.0, 1e4, false, false,
        &Calibration::max_mask_area_ratio},

@@ -105,6 +105,14 @@ struct Calibration {
   // content is ~10 µm, the gel's lag (which a slide's relaxation follows) ~50 ms. [0, 1].
   double slip_smoothing_s = 0.04;
 
+  // A contact that sticks while its normal load Σ z over Ω falls faster than this relative rate
+  // (1/s, smoothed with slip_smoothing_s) is being released: the gel it lets go of springs back,
+  // which the displacement proxy would read as the object moving back (a 2° stick rotation of a
+  // sphere read back by 1.3° as the pads opened). Its frames are dropped from the chosen reading.
+  // A held grasp's load stays: ≤ 0.9/s in the simulator's stick motions, ≤ 4.8/s in its slides;
+  // releases over 0.3 s reach 6–25/s (docs/dsp.md §4.2b). (0, 1e4]; 1e4 = off.
+  double release_load_rate = 4.0;
+
   // --- translation (contact-centroid displacement, paper Sec. IV-D)
   // If the mask changes by more than this fraction between frames (1 − Jaccard index), the
   // sliding rule's mask-centroid displacement is replaced by the mean displacement of the

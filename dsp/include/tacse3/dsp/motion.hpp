@@ -102,6 +102,13 @@ struct SensorMotion {
   double slip_relax_rate = 0.0;  // ρ (1/s), relative decay rate of the shear's rigid content
   double shear_shift_m = 0.0;    // |X| (m), rigid content of the shear read as a displacement
   double shear_rate_m_s = 0.0;   // |dX|/Δt (m/s), rigid content of this frame's increment
+  // ρ_L (1/s), relative rate at which the normal load Σ z over Ω falls (smoothed like X; < 0
+  // while it rises; every mode). kAuto counts only shear relaxation beyond it towards an onset.
+  double load_drop_rate = 0.0;
+  // Sticking (kDisplacement, or kAuto not slipping) with ρ_L > release_load_rate: the contact is
+  // being let go, and this frame's chosen reading is dropped (proxy_valid, translation_valid
+  // false); the velocity reading beside it is kept.
+  bool releasing = false;
   // --- the same frame as kVelocity would have read it: the velocity proxy's moments and ω, and
   // the sliding translation rule. Differs from the reading above only while kAuto sticks
   // (velocity_differs); otherwise a copy of it. The dual pipeline fuses both readings and pays
@@ -208,6 +215,12 @@ class MotionEstimator {
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();  // smoothed X
   Eigen::Vector3d change_ = Eigen::Vector3d::Zero();   // smoothed dX (over Ω_t ∩ Ω_{t−1})
   bool have_content_ = false;
+  // Normal load (every mode): smoothed L = Σ z over Ω, its smoothed change, L_{t−1} (nm).
+  double release_load_rate_ = 4.0;
+  double load_ = 0.0;
+  double load_change_ = 0.0;
+  double prev_load_ = 0.0;
+  bool have_load_ = false;
   void reset_detector() noexcept;
 };
 

@@ -57,6 +57,8 @@ struct SensorMotionRef {
   double slip_relax_rate = 0.0;
   double shear_shift_m = 0.0;
   double shear_rate_m_s = 0.0;
+  double load_drop_rate = 0.0;
+  bool releasing = false;  // as dsp::SensorMotion::releasing (the chosen reading is dropped)
   // The frame as kVelocity would have read it (dsp::SensorMotion's velocity_* fields).
   bool velocity_differs = false;
   std::vector<PointSample> velocity_samples;
@@ -70,13 +72,15 @@ struct SensorMotionRef {
 // A stick/slip decision to follow (kAuto only), taken from the fixed-point pipeline's
 // dsp::SensorMotion of the same frame: `slipping` is the proxy that frame used, `slip_onset`
 // whether the detector switched to slip at its end, `stick_confirmed` whether it confirmed a
-// stick (the dual pipeline's slip payback reads both). Used ONLY to measure the numeric
+// stick (the dual pipeline's slip payback reads both), `releasing` whether the frame's chosen
+// reading was dropped as a release (load falling faster than release_load_rate). Used ONLY to measure the numeric
 // fixed−ref difference with the detector's threshold crossings taken out ("decision-locked";
 // docs/dsp.md).
 struct SlipDecision {
   bool slipping = false;
   bool stick_confirmed = false;
   bool slip_onset = false;
+  bool releasing = false;
 };
 
 // Same rules as dsp::MotionEstimator (translation sources, proxy modes, λ), in double.
@@ -106,6 +110,9 @@ class MotionRef {
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d change_ = Eigen::Vector3d::Zero();
   bool have_content_ = false;
+  // Normal load (every mode): smoothed Σ z over Ω, its smoothed change, Σ z_{t−1} (m).
+  double load_ = 0.0, load_change_ = 0.0, prev_load_ = 0.0;
+  bool have_load_ = false;
   void reset_detector();
 };
 

@@ -36,6 +36,7 @@ class DecisionFollower {
       slip_[s].slipping = r.motion.slipping;
       slip_[s].stick_confirmed = r.motion.stick_confirmed;
       slip_[s].slip_onset = r.motion.slip_onset;
+      slip_[s].releasing = r.motion.releasing;
       dsp_ref::FixedDecisions& d = out_[s];
       d.slip = levels_.slip ? &slip_[s] : nullptr;
       d.flow.valid = levels_.flow ? &f.flow_valid : nullptr;
