@@ -78,7 +78,9 @@ struct Calibration {
   // exponentially with time constant slip_smoothing_s; dX is its change per frame, read from the
   // shear increments over the cells in both masks, Ω_t ∩ Ω_{t−1}, and smoothed alike.
   // Slip onset: the shear relaxes while loaded, ρ = −X·dX / (|X|² Δt) > slip_relax_rate_on for
-  // slip_on_frames consecutive frames with |X| > slip_min_shift_m. A sticking contact's shear is
+  // slip_on_frames consecutive frames with |X| > slip_min_shift_m. Only relaxation beyond the
+  // contact's relative loss of normal load counts (ρ − max(0, ρ_L)), and no frame whose load
+  // falls faster than release_load_rate (a contact being released, below). A sticking contact's shear is
   // the accumulated contact displacement and only shrinks if the object moves back; a sliding
   // contact's shear follows the sliding speed with the gel's lag, so it relaxes as the slide
   // slows and when it ends. Ranges: (0, 1e3] 1/s, [1, 1000], [0, 0.01] m.

@@ -157,6 +157,11 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 //  - Rotation: int64 moments over the proxy's cells, then in double the own-frame normal
 //    equations and solve3 with λ = λ_rel tr/3 + N · lever_floor²; per-axis scales
 //    rotation_scale (velocity proxy) or rotation_scale ⊙ displacement_rotation_ratio.
+//  - Release (docs/dsp.md §4.2b): the normal load L = Σ z over Ω and its relative rate of fall
+//    ρ_L, smoothed like X, in every mode. A sticking contact (kDisplacement, or kAuto not
+//    slipping) with ρ_L > release_load_rate is being let go (the gel springs back): this frame's
+//    chosen reading is dropped (`releasing`). kAuto's onset counts only ρ − max(0, ρ_L), and no
+//    frame with ρ_L > release_load_rate.
 //  - kAuto (per frame): both proxies' moments are summed in the same pass; the stick/slip
 //    detector (Calibration, docs/dsp.md) picks one. While sticking, the velocity proxy's reading
 //    (its ω and the sliding translation rule) is reported beside the displacement proxy's; the
