@@ -43,7 +43,10 @@ Status validate(const Calibration& c) noexcept {
   ok = ok && in_range(c.stick_confirm_s, 0.0, 10.0);
   ok = ok && c.slip_catchup_frames >= 1 && c.slip_catchup_frames <= 1000;
   ok = ok && in_range(c.slip_smoothing_s, 0.0, 1.0);
-  ok = ok && in_range_open_lo(c.release_load_rate, 0.0, 1e4);
+  ok = ok && in_range_open_lo(c.release_load_rate, 0.0, kReleaseRuleOff);
+  // The smoothed ρ_L cannot exceed 1/slip_smoothing_s: a rate at or above it would never act.
+  ok = ok &&
+       (c.release_load_rate >= kReleaseRuleOff || c.release_load_rate * c.slip_smoothing_s < 1.0);
   ok = ok && in_range_open_lo(c.c_velocity, 0.0, 100.0);
   ok = ok && in_range_open_lo(c.c_displacement, 0.0, 1.0);
   ok = ok && in_range(c.max_mask_change, 0.0, 1.0);

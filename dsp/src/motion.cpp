@@ -279,14 +279,14 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   sum_increment.store(mi);
 
   // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
-  // smoothed exponentially like X, and ρ_L = −(smoothed L_t − L_{t−1}) / (smoothed L · Δt), its
-  // relative rate of fall. When the pads open, the contact loses its load and the gel it lets go
+  // and its relative rate of fall ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) · Δt), EMA the
+  // exponential smoothing of X (so ρ_L < 1/slip_smoothing_s). When the pads open, the contact loses its load and the gel it lets go
   // of springs back: the shear's rigid content relaxes about as fast as the load falls (cylinder
   // ry 2° held, then released over 0.3 s: ρ 5.4/s against ρ_L 3.7/s at the frame the detector
   // used to call a slip, 9.1/s against 6.5/s at the next), and the displacement proxy reads the
   // spring-back as the object moving back. A grasp holds its load: ρ_L ≤ 2.7/s during the
-  // simulator's stick motions, ≤ 4.8/s in its slides, peaks of 6.5–24.5/s while a contact is
-  // released over 0.3 s (docs/dsp.md §4.2b).
+  // simulator's stick motions, ≤ 4.8/s in its slides, peaks of 6.5/s up to the ceiling while a
+  // contact is released over 0.3 s (docs/dsp.md §4.2b).
   if (m.n > 0) {
     const double alpha = content_alpha(dt_s, smoothing_s_);
     const double load = static_cast<double>(m.sz);
@@ -298,7 +298,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   } else {
     have_load_ = false;
   }
-  const bool unloading_fast = out.load_drop_rate > release_load_rate_;
+  const bool release_rule = release_load_rate_ < kReleaseRuleOff;
+  const bool unloading_fast = release_rule && out.load_drop_rate > release_load_rate_;
 
   // --- kAuto: the stick/slip detector on the rigid-body content of the shear and its increment.
   // The proxy of this frame is the one decided up to the previous frame.
@@ -331,7 +332,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
         // falls faster than release_load_rate (a release, below).
         const bool relaxing =
             out.shear_shift_m > min_shift_m_ && !unloading_fast &&
-            out.slip_relax_rate - std::max(0.0, out.load_drop_rate) > relax_rate_on_;
+            out.slip_relax_rate - (release_rule ? std::max(0.0, out.load_drop_rate) : 0.0) >
+                relax_rate_on_;
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
         rest_s_ = rest ? rest_s_ + dt_s : 0.0;
         // Unloaded (|X| ≤ slip_min_shift_m, the least shift an onset needs): any slide it could be

@@ -89,6 +89,10 @@ std::vector<BadCase> bad_cases() {
   add("area ratio 1e5", [](Calibration& c) { c.max_mask_area_ratio = 1e5; });
   add("release rate zero", [](Calibration& c) { c.release_load_rate = 0.0; });
   add("release rate 1e5", [](Calibration& c) { c.release_load_rate = 1e5; });
+  add("release rate at the smoothing's ceiling", [](Calibration& c) {
+    c.slip_smoothing_s = 0.25;
+    c.release_load_rate = 4.0;  // ρ_L < 1/0.25 = 4/s: it could never act
+  });
   add("scale 1000", [](Calibration& c) { c.translation_scale[0] = 1000.0; });
   add("L = 0", [](Calibration& c) { c.moving_average_length = 0; });
   add("L > max", [](Calibration& c) { c.moving_average_length = kMaxMovingAverage + 1; });
@@ -116,9 +120,12 @@ TEST(Calibration, RangeBoundsAreInclusiveWhereDocumented) {
   EXPECT_EQ(validate(c), Status::kOk);
   c.max_mask_area_ratio = 1e4;  // off
   EXPECT_EQ(validate(c), Status::kOk);
-  c.release_load_rate = 1e4;  // off
+  c.release_load_rate = kReleaseRuleOff;  // off, whatever the smoothing
+  c.slip_smoothing_s = 1.0;
   EXPECT_EQ(validate(c), Status::kOk);
-  c.release_load_rate = 1e-3;  // (0, 1e4]: any positive rate
+  c.release_load_rate = 0.999;  // below 1/slip_smoothing_s
+  EXPECT_EQ(validate(c), Status::kOk);
+  c.release_load_rate = 1e-3;
   EXPECT_EQ(validate(c), Status::kOk);
 }
 

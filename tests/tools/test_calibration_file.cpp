@@ -135,7 +135,8 @@ TEST(CalibrationFile, RoundTripIsExact) {
   EXPECT_NE(text.find("[sensor]\npixel_pitch_m = 1e-04\n"), std::string::npos) << text;
   EXPECT_NE(text.find("[right]\nvelocity_proxy = \"auto\"\nc_velocity = 0.0081\n"
                       "slip_relax_rate_on = 2.5\nslip_on_frames = 6\nstick_confirm_s = 0.75\n"
-                      "release_load_rate = 6.5\nmax_mask_area_ratio = 2.25\ntranslation_scale = [1.1, 0.9, 1.0]"),
+                      "release_load_rate = 6.5\nmax_mask_area_ratio = 2.25\ntranslation_scale = "
+                      "[1.1, 0.9, 1.0]"),
             std::string::npos)
       << text;
   EXPECT_NE(text.find("velocity_proxy = \"displacement\""), std::string::npos);
@@ -246,6 +247,9 @@ TEST(CalibrationFile, CrossFieldRulesNameBothKeys) {
   expect_error(
       kHead + "[left]\ncontact_tau_on = 0.01\ncontact_tau_off = 0.02\n",
       {"cal.toml", "\"left.contact_tau_off\" (0.02) must not exceed", "left.contact_tau_on"});
+  expect_error(kHead + "[right]\nslip_smoothing_s = 0.5\nrelease_load_rate = 2.5\n",
+               {"\"right.release_load_rate\" (2.5) must be below 1 / \"right.slip_smoothing_s\"",
+                "or 1e4 (off)"});
   // Merged values count: [sensor] sets τ_off high, [right] lowers τ_on below it.
   expect_error(kHead + "[sensor]\ncontact_tau_off = 0.015\n[right]\ncontact_tau_on = 0.012\n",
                {"\"right.contact_tau_off\""});

@@ -53,7 +53,8 @@ int parse_options(int argc, char** argv, Options* o) {
   app.add_option("--motion-s", o->motion_s, "Motion duration (s); 0 = auto from the magnitude")
       ->capture_default_str();
   app.add_option("--hold-s", o->hold_s, "Static hold after the motion (s)")->capture_default_str();
-  app.add_option("--release-s", o->release_s, "Pads opening after the hold, contact lost (s); 0 = none")
+  app.add_option("--release-s", o->release_s,
+                 "Pads opening after the hold, contact lost (s); 0 = none")
       ->capture_default_str();
   app.add_option("--fps", o->fps, "Frame rate")->capture_default_str();
   app.add_option("--sensors", o->sensors, "Sensors to record: both, left or right")

@@ -100,6 +100,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
                                   const SlipDecision* follow) {
   const auto n = static_cast<std::size_t>(dsp::kGridCount);
   const bool automatic = cal_.velocity_proxy == dsp::VelocityProxy::kAuto;
+  // The releasing decision is followed in every mode, the slip decisions only in kAuto.
+  const SlipDecision* const release_follow = follow;
   if (!automatic) follow = nullptr;
   SensorMotionRef out;
   if (follow != nullptr && follow->slipping != slipping_) {
@@ -171,7 +173,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   } else {
     have_load_ = false;
   }
-  const bool unloading_fast = out.load_drop_rate > cal_.release_load_rate;
+  const bool release_rule = cal_.release_load_rate < dsp::kReleaseRuleOff;
+  const bool unloading_fast = release_rule && out.load_drop_rate > cal_.release_load_rate;
 
   const bool sticking =
       automatic ? !slipping_ : cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
@@ -219,7 +222,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       } else if (!slipping_) {
         const bool relaxing =
             out.shear_shift_m > cal_.slip_min_shift_m && !unloading_fast &&
-            out.slip_relax_rate - std::max(0.0, out.load_drop_rate) > cal_.slip_relax_rate_on;
+            out.slip_relax_rate - (release_rule ? std::max(0.0, out.load_drop_rate) : 0.0) >
+                cal_.slip_relax_rate_on;
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
         rest_s_ = rest ? rest_s_ + dt : 0.0;
         // Unloaded (|X| ≤ slip_min_shift_m) and at rest for slip_on_frames frames: stuck.
@@ -243,8 +247,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   }
   // A sticking contact losing its load faster than release_load_rate is being let go: its
   // chosen reading is dropped (dsp::MotionEstimator's rule; the followed decision if given).
-  out.releasing = follow != nullptr ? follow->releasing
-                                    : sticking && out.points > 0 && unloading_fast;
+  out.releasing = release_follow != nullptr ? release_follow->releasing
+                                            : sticking && out.points > 0 && unloading_fast;
   out.proxy_valid = (!sticking || have_prev_shear_) && !out.releasing;
   out.velocity_differs = automatic && sticking;
   for (auto& p : shear_pts) p.v *= cal_.c_velocity;

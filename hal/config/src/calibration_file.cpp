@@ -569,6 +569,13 @@ Status validate(const CalibrationSet& set, const std::string& origin) noexcept {
                              fmt_real(c.contact_tau_off) + ") must not exceed \"" + names[i] +
                              ".contact_tau_on\" (" + fmt_real(c.contact_tau_on) + ")");
       }
+      if (c.release_load_rate < dsp::kReleaseRuleOff &&
+          c.release_load_rate * c.slip_smoothing_s >= 1.0) {
+        return Status::error(origin + ": key \"" + names[i] + ".release_load_rate\" (" +
+                             fmt_real(c.release_load_rate) + ") must be below 1 / \"" + names[i] +
+                             ".slip_smoothing_s\" (" + fmt_real(c.slip_smoothing_s) +
+                             "), the largest rate the smoothed load can show, or 1e4 (off)");
+      }
       const Field& rot = *find_field("rotation_scale");
       for (const auto* v : {&set.paper[i].rotation_scale, &set.paper[i].translation_scale}) {
         for (double x : *v) {

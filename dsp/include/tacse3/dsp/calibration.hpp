@@ -28,6 +28,9 @@ enum class VelocityProxy : std::uint8_t {
 
 // Largest moving-average window (frames). Sizes the ring buffer at compile time.
 inline constexpr int kMaxMovingAverage = 32;
+// Calibration::release_load_rate at or above this turns the release rule off entirely
+// (docs/dsp.md §4.2b).
+inline constexpr double kReleaseRuleOff = 1e4;
 
 // All fields are doubles in SI units (or dimensionless); they are validated by validate() and
 // converted once to the fixed-point formats of the per-grid stages by each stage's configure().
@@ -80,10 +83,10 @@ struct Calibration {
   // Slip onset: the shear relaxes while loaded, ρ = −X·dX / (|X|² Δt) > slip_relax_rate_on for
   // slip_on_frames consecutive frames with |X| > slip_min_shift_m. Only relaxation beyond the
   // contact's relative loss of normal load counts (ρ − max(0, ρ_L)), and no frame whose load
-  // falls faster than release_load_rate (a contact being released, below). A sticking contact's shear is
-  // the accumulated contact displacement and only shrinks if the object moves back; a sliding
-  // contact's shear follows the sliding speed with the gel's lag, so it relaxes as the slide
-  // slows and when it ends. Ranges: (0, 1e3] 1/s, [1, 1000], [0, 0.01] m.
+  // falls faster than release_load_rate (a contact being released, below). A sticking contact's
+  // shear is the accumulated contact displacement and only shrinks if the object moves back; a
+  // sliding contact's shear follows the sliding speed with the gel's lag, so it relaxes as the
+  // slide slows and when it ends. Ranges: (0, 1e3] 1/s, [1, 1000], [0, 0.01] m.
   double slip_relax_rate_on = 3.0;
   int slip_on_frames = 4;
   double slip_min_shift_m = 20e-6;
@@ -108,11 +111,15 @@ struct Calibration {
   double slip_smoothing_s = 0.04;
 
   // A contact that sticks while its normal load Σ z over Ω falls faster than this relative rate
-  // (1/s, smoothed with slip_smoothing_s) is being released: the gel it lets go of springs back,
-  // which the displacement proxy would read as the object moving back (a 2° stick rotation of a
-  // sphere read back by 1.3° as the pads opened). Its frames are dropped from the chosen reading.
-  // A held grasp's load stays: ≤ 0.9/s in the simulator's stick motions, ≤ 4.8/s in its slides;
-  // releases over 0.3 s reach 6–25/s (docs/dsp.md §4.2b). (0, 1e4]; 1e4 = off.
+  // (1/s; ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) Δt), EMA with slip_smoothing_s) is being released:
+  // the gel it lets go of springs back, which the displacement proxy read as the object moving
+  // back (a 2° stick rotation of a sphere read back by 1.43° as the pads opened), and whose
+  // relaxation started false slips. Its frames' chosen readings are dropped and count
+  // towards no slip onset, and the onset counts only relaxation beyond ρ_L. A held grasp's load
+  // stays: ≤ 2.7/s in the simulator's stick motions, ≤ 4.8/s in its slides; releases over 0.3 s
+  // reach the smoothing's ceiling (ρ_L < 1/slip_smoothing_s, 25/s by default) (docs/dsp.md
+  // §4.2b). (0, 1/slip_smoothing_s), or ≥ kReleaseRuleOff (1e4) for off; at most 1e4. Needs a
+  // height estimate (height_gain_m > 0): without one L = 0 and the rule never acts.
   double release_load_rate = 4.0;
 
   // --- translation (contact-centroid displacement, paper Sec. IV-D)

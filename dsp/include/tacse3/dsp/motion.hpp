@@ -107,7 +107,8 @@ struct SensorMotion {
   double load_drop_rate = 0.0;
   // Sticking (kDisplacement, or kAuto not slipping) with ρ_L > release_load_rate: the contact is
   // being let go, and this frame's chosen reading is dropped (proxy_valid, translation_valid
-  // false); the velocity reading beside it is kept.
+  // false, ω = 0). The velocity reading beside it (kAuto) is kept: it only counts if a slide is
+  // detected afterwards (the payback's deficit), and a releasing frame may be a slide's.
   bool releasing = false;
   // --- the same frame as kVelocity would have read it: the velocity proxy's moments and ω, and
   // the sliding translation rule. Differs from the reading above only while kAuto sticks

@@ -25,7 +25,7 @@ struct SimCase {
   double indentation_mm = 1.0;
   double hold_s = 0.4;  // hold after the motion
   double approach_s = 0.1, grasp_s = 0.4, settle_s = 0.1;
-  double release_s = 0.0;  // pads opening after the hold (0 = none)
+  double release_s = 0.0;     // pads opening after the hold (0 = none)
   std::string label() const;  // "sphere rz 30"
   // The equivalent tacse3-sim options (for docs and messages).
   std::string sim_arguments() const;
