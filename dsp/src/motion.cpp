@@ -280,13 +280,15 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
 
   // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
   // and its relative rate of fall ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) · Δt), EMA the
-  // exponential smoothing of X (so ρ_L < 1/slip_smoothing_s). When the pads open, the contact loses its load and the gel it lets go
-  // of springs back: the shear's rigid content relaxes about as fast as the load falls (cylinder
-  // ry 2° held, then released over 0.3 s: ρ 5.4/s against ρ_L 3.7/s at the frame the detector
-  // used to call a slip, 9.1/s against 6.5/s at the next), and the displacement proxy reads the
-  // spring-back as the object moving back. A grasp holds its load: ρ_L ≤ 2.7/s during the
-  // simulator's stick motions, ≤ 4.8/s in its slides, peaks of 6.5/s up to the ceiling while a
-  // contact is released over 0.3 s (docs/dsp.md §4.2b).
+  // exponential smoothing of X (so ρ_L ≤ 1/slip_smoothing_s at a constant frame period). When
+  // the pads open, the contact loses its load and the gel it lets go of springs back: the
+  // shear's rigid content relaxes about as fast as the load falls (cylinder ry 2° held, then
+  // released over 0.3 s: ρ 5.4/s against ρ_L 3.7/s at the frame the detector used to call a
+  // slip, 9.1/s against 6.5/s at the next), and the displacement proxy reads the spring-back as
+  // the object moving back. A grasp holds its load: ρ_L ≤ 2.7/s during the simulator's stick
+  // motions, ≤ 4.8/s in its slides whose contact stays (5.7/s for two frames as a screwdriver
+  // handle's flute passes), peaks of 6.5/s up to the ceiling while a contact is released over
+  // 0.3 s (docs/dsp.md §4.2b).
   if (m.n > 0) {
     const double alpha = content_alpha(dt_s, smoothing_s_);
     const double load = static_cast<double>(m.sz);

@@ -127,6 +127,9 @@ TEST(Calibration, RangeBoundsAreInclusiveWhereDocumented) {
   EXPECT_EQ(validate(c), Status::kOk);
   c.release_load_rate = 1e-3;
   EXPECT_EQ(validate(c), Status::kOk);
+  c.slip_smoothing_s = 0.0;  // no smoothing, no ceiling: any rate up to 1e4
+  c.release_load_rate = 9999.0;
+  EXPECT_EQ(validate(c), Status::kOk);
 }
 
 TEST(Calibration, StagesRejectBadCalibrationAndKeepTheirGains) {

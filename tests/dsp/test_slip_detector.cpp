@@ -421,8 +421,8 @@ TEST(SlipDetector, ContactLossRestartsSticking) {
 //  - no slip onset (only relaxation beyond the load's fall counts), so the velocity proxy's
 //    reading of the held shear (the deficit, ≈ 12° here) is never paid;
 //  - the frames whose load falls faster than release_load_rate drop the displacement proxy's
-//    reading of the spring-back, so the pose stays near 2° (with the rule off it reads most of
-//    the way back to 0°);
+//    reading of the spring-back, so the pose stays near 2° (kDisplacement with the rule off
+//    reads most of the way back to 0°; kAuto with it off also calls a slip and overshoots);
 //  - the same in kDisplacement, never in kVelocity (no chosen reading of increments);
 //  - the reference decides every frame the same and integrates the same rotation.
 TEST(SlipDetector, AReleasedStuckContactIsNeitherASlipNorAMotionBack) {
@@ -555,6 +555,7 @@ TEST(SlipDetector, NoSlipOnsetWhileTheLoadFallsFasterThanTheReleaseRate) {
   EXPECT_TRUE(mr.releasing);
   EXPECT_FALSE(mr.proxy_valid);
   EXPECT_FALSE(mr.translation_valid);
+  EXPECT_EQ(mr.omega, Eigen::Vector3d::Zero());
 }
 
 // The decision-locked reference (dsp_ref::SlipDecision, used only to report a second fixed−ref

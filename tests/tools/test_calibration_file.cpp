@@ -250,6 +250,9 @@ TEST(CalibrationFile, CrossFieldRulesNameBothKeys) {
   expect_error(kHead + "[right]\nslip_smoothing_s = 0.5\nrelease_load_rate = 2.5\n",
                {"\"right.release_load_rate\" (2.5) must be below 1 / \"right.slip_smoothing_s\"",
                 "or 1e4 (off)"});
+  // Merged: [sensor] sets the smoothing, [left] a rate above its ceiling.
+  expect_error(kHead + "[sensor]\nslip_smoothing_s = 0.5\n[left]\nrelease_load_rate = 2.5\n",
+               {"\"left.release_load_rate\" (2.5) must be below 1 / \"left.slip_smoothing_s\""});
   // Merged values count: [sensor] sets τ_off high, [right] lowers τ_on below it.
   expect_error(kHead + "[sensor]\ncontact_tau_off = 0.015\n[right]\ncontact_tau_on = 0.012\n",
                {"\"right.contact_tau_off\""});

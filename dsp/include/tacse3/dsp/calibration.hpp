@@ -113,11 +113,12 @@ struct Calibration {
   // A contact that sticks while its normal load Σ z over Ω falls faster than this relative rate
   // (1/s; ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) Δt), EMA with slip_smoothing_s) is being released:
   // the gel it lets go of springs back, which the displacement proxy read as the object moving
-  // back (a 2° stick rotation of a sphere read back by 1.43° as the pads opened), and whose
+  // back (a 2° stick rotation of a sphere ended 1.43° off as the pads opened), and whose
   // relaxation started false slips. Its frames' chosen readings are dropped and count
   // towards no slip onset, and the onset counts only relaxation beyond ρ_L. A held grasp's load
-  // stays: ≤ 2.7/s in the simulator's stick motions, ≤ 4.8/s in its slides; releases over 0.3 s
-  // reach the smoothing's ceiling (ρ_L < 1/slip_smoothing_s, 25/s by default) (docs/dsp.md
+  // stays: ≤ 2.7/s in the simulator's stick motions, ≤ 4.8/s in its slides whose contact stays
+  // (5.7/s for two frames as a screwdriver handle's flute passes); releases over 0.3 s reach the
+  // smoothing's ceiling (ρ_L ≤ 1/slip_smoothing_s, 25/s by default) (docs/dsp.md
   // §4.2b). (0, 1/slip_smoothing_s), or ≥ kReleaseRuleOff (1e4) for off; at most 1e4. Needs a
   // height estimate (height_gain_m > 0): without one L = 0 and the rule never acts.
   double release_load_rate = 4.0;

@@ -69,13 +69,13 @@ struct SensorMotionRef {
   Eigen::Vector3d velocity_translation_point = Eigen::Vector3d::Zero();
 };
 
-// A stick/slip decision to follow (kAuto only), taken from the fixed-point pipeline's
-// dsp::SensorMotion of the same frame: `slipping` is the proxy that frame used, `slip_onset`
-// whether the detector switched to slip at its end, `stick_confirmed` whether it confirmed a
-// stick (the dual pipeline's slip payback reads both), `releasing` whether the frame's chosen
-// reading was dropped as a release (load falling faster than release_load_rate). Used ONLY to measure the numeric
-// fixed−ref difference with the detector's threshold crossings taken out ("decision-locked";
-// docs/dsp.md).
+// A stick/slip decision to follow, taken from the fixed-point pipeline's dsp::SensorMotion of
+// the same frame (the slip fields in kAuto only, `releasing` in every mode): `slipping` is the
+// proxy that frame used, `slip_onset` whether the detector switched to slip at its end,
+// `stick_confirmed` whether it confirmed a stick (the dual pipeline's slip payback reads both),
+// `releasing` whether the frame's chosen reading was dropped as a release (load falling faster
+// than release_load_rate). Used ONLY to measure the numeric fixed−ref difference with the
+// detector's threshold crossings taken out ("decision-locked"; docs/dsp.md).
 struct SlipDecision {
   bool slipping = false;
   bool stick_confirmed = false;
@@ -89,8 +89,9 @@ class MotionRef {
   explicit MotionRef(const dsp::Calibration& cal = {});
   void reset();
   // shear_x/shear_y: calibrated shear (shear units, real values) per grid point.
-  // follow (kAuto only, may be null): take the stick/slip transitions from this decision instead
-  // of the reference's own detector (whose features are still computed and reported).
+  // follow (may be null): take the stick/slip transitions (kAuto only) and the releasing flag
+  // (every mode) from this decision instead of the reference's own detector (whose features are
+  // still computed and reported).
   SensorMotionRef update(const ContactSetRef& c, const std::vector<double>& shear_x,
                          const std::vector<double>& shear_y, double dt,
                          const SlipDecision* follow = nullptr);
