@@ -210,8 +210,6 @@ void MotionEstimator::reset() noexcept {
   have_prev_shear_ = false;
   load_ = 0.0;
   load_change_ = 0.0;
-  prev_load_ = 0.0;
-  have_load_ = false;
   reset_detector();
 }
 
@@ -289,16 +287,16 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // motions, ≤ 4.8/s in its slides whose contact stays (5.7/s for two frames as a screwdriver
   // handle's flute passes), peaks of 6.5/s up to the ceiling while a contact is released over
   // 0.3 s (docs/dsp.md §4.2b).
+  // L_{t−1} is prev_sz_ (kept for the sliding rule); a contact's first frame starts the EMA.
   if (m.n > 0) {
     const double alpha = content_alpha(dt_s, smoothing_s_);
     const double load = static_cast<double>(m.sz);
-    load_change_ = have_load_ ? load_change_ + alpha * ((load - prev_load_) - load_change_) : 0.0;
-    load_ = have_load_ ? load_ + alpha * (load - load_) : load;
-    prev_load_ = load;
-    have_load_ = true;
+    const bool had_load = prev_count_ > 0;
+    load_change_ = had_load ? load_change_ + alpha * ((load - static_cast<double>(prev_sz_)) -
+                                                      load_change_)
+                            : 0.0;
+    load_ = had_load ? load_ + alpha * (load - load_) : load;
     out.load_drop_rate = load_ > 0.0 ? -load_change_ / (load_ * dt_s) : 0.0;
-  } else {
-    have_load_ = false;
   }
   const bool release_rule = release_load_rate_ < kReleaseRuleOff;
   const bool unloading_fast = release_rule && out.load_drop_rate > release_load_rate_;

@@ -90,8 +90,7 @@ void MotionRef::reset() {
   prev_sx_.assign(n, 0.0);
   prev_sy_.assign(n, 0.0);
   have_prev_shear_ = false;
-  load_ = load_change_ = prev_load_ = 0.0;
-  have_load_ = false;
+  load_ = load_change_ = 0.0;
   reset_detector();
 }
 
@@ -163,15 +162,13 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   };
 
   // Normal load Σ z over Ω, smoothed like X, and its relative rate of fall ρ_L (every mode).
+  // L_{t−1} is z_prev (Σ z over the previous mask); a contact's first frame starts the EMA.
   if (out.points > 0) {
     const double alpha = cal_.slip_smoothing_s > 0.0 ? dt / (cal_.slip_smoothing_s + dt) : 1.0;
-    load_change_ = have_load_ ? load_change_ + alpha * ((z_now - prev_load_) - load_change_) : 0.0;
-    load_ = have_load_ ? load_ + alpha * (z_now - load_) : z_now;
-    prev_load_ = z_now;
-    have_load_ = true;
+    const bool had_load = prev_count > 0;
+    load_change_ = had_load ? load_change_ + alpha * ((z_now - z_prev) - load_change_) : 0.0;
+    load_ = had_load ? load_ + alpha * (z_now - load_) : z_now;
     out.load_drop_rate = load_ > 0.0 ? -load_change_ / (load_ * dt) : 0.0;
-  } else {
-    have_load_ = false;
   }
   const bool release_rule = cal_.release_load_rate < dsp::kReleaseRuleOff;
   const bool unloading_fast = release_rule && out.load_drop_rate > cal_.release_load_rate;

@@ -221,12 +221,11 @@ class MotionEstimator {
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();  // smoothed X
   Eigen::Vector3d change_ = Eigen::Vector3d::Zero();   // smoothed dX (over Ω_t ∩ Ω_{t−1})
   bool have_content_ = false;
-  // Normal load (every mode): smoothed L = Σ z over Ω, its smoothed change, L_{t−1} (nm).
+  // Normal load (every mode): smoothed L = Σ z over Ω and its smoothed change (nm); L_{t−1} is
+  // prev_sz_.
   double release_load_rate_ = 4.0;
   double load_ = 0.0;
   double load_change_ = 0.0;
-  double prev_load_ = 0.0;
-  bool have_load_ = false;
   void reset_detector() noexcept;
 };
 

@@ -111,9 +111,8 @@ class MotionRef {
   Eigen::Vector3d content_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d change_ = Eigen::Vector3d::Zero();
   bool have_content_ = false;
-  // Normal load (every mode): smoothed Σ z over Ω, its smoothed change, Σ z_{t−1} (m).
-  double load_ = 0.0, load_change_ = 0.0, prev_load_ = 0.0;
-  bool have_load_ = false;
+  // Normal load (every mode): smoothed Σ z over Ω and its smoothed change (m).
+  double load_ = 0.0, load_change_ = 0.0;
   void reset_detector();
 };
 
