@@ -292,9 +292,9 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     const double alpha = content_alpha(dt_s, smoothing_s_);
     const double load = static_cast<double>(m.sz);
     const bool had_load = prev_count_ > 0;
-    load_change_ = had_load ? load_change_ + alpha * ((load - static_cast<double>(prev_sz_)) -
-                                                      load_change_)
-                            : 0.0;
+    load_change_ =
+        had_load ? load_change_ + alpha * ((load - static_cast<double>(prev_sz_)) - load_change_)
+                 : 0.0;
     load_ = had_load ? load_ + alpha * (load - load_) : load;
     out.load_drop_rate = load_ > 0.0 ? -load_change_ / (load_ * dt_s) : 0.0;
   }
