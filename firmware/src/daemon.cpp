@@ -289,6 +289,8 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
   ec.configured = {board.sensors[0].enabled, board.sensors[1].enabled};
   ec.rate_divider = static_cast<std::uint8_t>(board.can.rate_divider);
   ec.velocity_mode = board.pipeline.velocity_proxy;
+  ec.frame_period_ns =
+      1'000'000'000LL / (board.sensors[0].enabled ? board.sensors[0].fps : board.sensors[1].fps);
   std::array<hal::Camera*, 2> cams{d->cameras_[0].get(), d->cameras_[1].get()};
   std::array<FrameRing*, 2> rings{board.sensors[0].enabled ? &(*d->rings_)[0] : nullptr,
                                   board.sensors[1].enabled ? &(*d->rings_)[1] : nullptr};

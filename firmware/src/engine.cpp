@@ -279,6 +279,7 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   (use_left && use_right ? stats_.pairs : stats_.singles) += 1;
   shared_.cycles.store(stats_.samples, std::memory_order_relaxed);
   status_sent_this_cycle_ = false;
+  last_cycle_ns_ = now_ns;
 
   for (std::size_t s = 0; s < 2; ++s) {
     const bool present = result_.present[s];
@@ -481,14 +482,20 @@ bool Engine::step(std::int64_t now_ns) noexcept {
   }
   update_state(now_ns);
 
-  // Status: the periodic group at 10 Hz; a change-triggered Status at most once per cycle.
+  // Status: the periodic group at 10 Hz; a change-triggered Status at most once per cycle, or,
+  // once the stream has stopped (no cycle for two frame periods: the second pad of a board going
+  // a few ms after the first, with no cycle left to count), once per frame period.
+  const bool stream_stopped = now_ns - last_cycle_ns_ >= 2 * config_.frame_period_ns &&
+                              now_ns - last_status_ns_ >= config_.frame_period_ns;
   if (now_ns >= next_status_ns_) {
     send_status_group();
+    last_status_ns_ = now_ns;
     next_status_ns_ += config_.status_period_ns;
     if (next_status_ns_ <= now_ns) next_status_ns_ = now_ns + config_.status_period_ns;
     worked = true;
-  } else if (status_dirty_ && !status_sent_this_cycle_) {
+  } else if (status_dirty_ && (!status_sent_this_cycle_ || stream_stopped)) {
     send_status_change();
+    last_status_ns_ = now_ns;
     worked = true;
   }
   channel_.service();

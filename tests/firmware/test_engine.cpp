@@ -304,6 +304,47 @@ TEST_F(EngineTest, BothSensorsLostIsAFault) {
   EXPECT_LE(engine_->stats().status_groups, groups + 10);
 }
 
+// The two pads of one board go a few ms apart (a sysfs unbind removes them one after the other)
+// with no cycle in between: the DEGRADED Status goes out for the first, and the FAULT for the
+// second must not wait for the next 10 Hz group (up to 100 ms) because "one change-triggered
+// Status per cycle" had no cycle left to count. With no cycle running, one per frame period.
+TEST_F(EngineTest, SecondSensorLostWithoutACycleBetweenIsReportedAtOnce) {
+  // 13 ticks: the last one (at 100.5 ms) carries the periodic group, the next is due at 200 ms.
+  for (std::size_t i = 0; i < 13; ++i) tick(i);
+  const std::int64_t t_last = now_;
+  const auto statuses_before = decode().statuses.size();
+  const std::uint64_t groups = engine_->stats().status_groups;
+  // The left pad goes 20 ms after the last cycle (two frame periods: the stream has stopped),
+  // the right 1 ms later; the loop steps every ms.
+  std::int64_t t_degraded = -1;
+  std::int64_t t_fault = -1;
+  for (std::int64_t t = t_last + 20'000'000; t < t_last + 60'000'000; t += 1'000'000) {
+    if (t == t_last + 20'000'000) shared_.sensors[0].disconnected.store(true);
+    if (t == t_last + 21'000'000) shared_.sensors[1].disconnected.store(true);
+    engine_->step(t);
+    const auto b = decode();
+    if (b.statuses.size() == statuses_before) continue;
+    const protocol::State st = b.statuses.back().state;
+    if (st == protocol::State::kDegradedSingleSensor && t_degraded < 0) t_degraded = t;
+    if (st == protocol::State::kFault) {
+      t_fault = t;
+      break;
+    }
+  }
+  ASSERT_EQ(engine_->stats().status_groups, groups) << "a periodic group fell in the window";
+  // The left's loss at once, the right's one frame period after that, not at the 10 Hz group
+  // 80 ms later.
+  EXPECT_EQ(t_degraded, t_last + 20'000'000);
+  ASSERT_GE(t_fault, 0) << "no FAULT Status within 60 ms of the second loss";
+  EXPECT_GE(t_fault - t_degraded, kPeriod);
+  EXPECT_LE(t_fault - t_degraded, kPeriod + 1'000'000);
+  const auto b = decode();
+  EXPECT_EQ(b.statuses.back().fault, protocol::FaultCode::kBothSensorsLost);
+  EXPECT_EQ(b.statuses.back().health_left, protocol::SensorHealth::kLost);
+  // Two Status frames in the window, not one per step.
+  EXPECT_EQ(b.statuses.size(), statuses_before + 2);
+}
+
 // A slow core with a backlog of frames must not hold the 10 Hz Status back: one step processes
 // at most one cycle, then the Status check runs.
 TEST_F(EngineTest, BacklogDoesNotStarveTheStatus) {

@@ -61,6 +61,12 @@ struct EngineConfig {
   bool stream_enabled = true;
   protocol::VelocityMode velocity_mode = protocol::VelocityMode::kAuto;
   std::int64_t status_period_ns = 100'000'000;  // 10 Hz
+  // The sensors' nominal frame period. A change-triggered Status goes out at most once per
+  // processed cycle. When the stream has stopped (no cycle for two periods: both pads gone), a
+  // change goes out once a period has passed since the last Status, instead of waiting for the
+  // next 10 Hz group; it fills a cycle slot that stayed empty, so the budget of one Status per
+  // frame period holds (docs/can-protocol.md).
+  std::int64_t frame_period_ns = 8'333'333;  // 120 Hz
 };
 
 struct EngineStats {
@@ -145,6 +151,8 @@ class Engine {
   std::int64_t last_t_ns_ = INT64_MIN;
   std::int64_t last_pair_t_ns_ = INT64_MIN;
   std::int64_t next_status_ns_ = 0;
+  std::int64_t last_status_ns_ = 0;  // loop clock of the last Status, periodic or on change
+  std::int64_t last_cycle_ns_ = 0;   // loop clock of the last processed cycle
   std::uint64_t sample_index_ = 0;
   std::uint8_t cycle_counter_ = 0;
   std::uint8_t status_counter_ = 0;

@@ -457,7 +457,8 @@ inline constexpr std::array<MessageDef, 12> kMessages = {{
      "Position of the object in G since the last pose reset"},
     {MessageId::kCycleFd, "CycleFd", 64, true, Sender::kGripper, Stream::kFdCycle, kCycleRateHz,
      kCycleRateHz, table::kCycleFd, "CAN FD mode: a whole cycle in one frame"},
-    // Status: 10 Hz, plus one immediately on a change, at most one per cycle in total.
+    // Status: 10 Hz, plus one immediately on a change, at most one per cycle (per frame period
+    // once the stream has stopped) in total.
     {MessageId::kStatus, "Status", 8, false, Sender::kGripper, Stream::kAlways, kStatusRateHz,
      kCycleRateHz, table::kStatus, "Heartbeat: state, sensor health, flags, configuration"},
     {MessageId::kStatusContact, "StatusContact", 8, false, Sender::kGripper, Stream::kAlways,
