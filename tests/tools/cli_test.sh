@@ -48,6 +48,27 @@ check "bad --mode is named" contains "$T/e3" "mode"
 "$REPLAY" > /dev/null 2>&1
 check "no arguments is an error" test $? -ne 0
 
+# --slip-log on a grasp that ends with the pads opening over 0.2 s (docs/replay.md, dsp.md 4.2b):
+# one row per present sensor and frame; 'releasing' only within the release, and there with a
+# load falling faster than the default release_load_rate (4/s); a 2 deg stick motion never slips.
+"$SIM" -q --out "$T/rel" --object sphere --motion rz --magnitude 2 --colour grey \
+  --approach-s 0.05 --grasp-s 0.2 --settle-s 0.05 --hold-s 0.1 --release-s 0.2 ||
+  { echo "FAIL tacse3-sim --release-s"; exit 1; }
+rel_frames=$(($(wc -l < "$T/rel/frames.csv") - 1))
+t_release=$(tail -1 "$T/rel/frames.csv" | awk -F, '{ print $2 - 200000000 }')
+"$REPLAY" "$T/rel" --out "$T/rel.csv" --slip-log "$T/slip.csv" -q
+check "replay --slip-log exits 0" test $? -eq 0
+check "slip log header" test "$(head -1 "$T/slip.csv")" = \
+  "t_ns,sensor,contact,slipping,onset,stick_confirmed,relax_rate_per_s,shift_m,rate_m_s,load_drop_per_s,releasing"
+check "slip log: a row per sensor and frame" test "$(($(wc -l < "$T/slip.csv") - 1))" -eq $((2 * rel_frames))
+awk -F, -v t0="$t_release" 'NR > 1 && $11 == 1 { n[$2]++; if ($1 < t0 || $10 <= 4) bad++ }
+  END { exit !(n["left"] >= 1 && n["right"] >= 1 && bad == 0) }' "$T/slip.csv"
+check "slip log: releasing on both pads, only in the release, load falling > 4/s" test $? -eq 0
+awk -F, -v t0="$t_release" 'NR > 1 && $1 < t0 && $10 > 4 { bad++ } END { exit bad > 0 }' \
+  "$T/slip.csv"
+check "slip log: no load falling > 4/s before the release" test $? -eq 0
+check "slip log: a 2 deg stick motion never slips" test -z "$(awk -F, 'NR > 1 && $4 != 0' "$T/slip.csv")"
+
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"
 check "calibrate without truth exits 1" test $? -eq 1
