@@ -373,10 +373,14 @@ TEST(Accuracy, TheFlowTracksThePressedGelEverywhere) {
 // as well): the textured cube's flat face is first seen at one corner (4 cells, then 54, 101,
 // 177), the velocity reading jumps by (6.4, -6.4) mm in the grasp, and its grasp is loaded
 // (28 µm of planar shear content), so no stick is confirmed before the slide and `auto` paid
-// the jump back: 9.45 mm off for 10 mm with the bound off, 0.40 mm with it.
+// the jump back: 9.45 mm off for 10 mm with the bound off, 0.40 mm with it. That content sits
+// close to slip_min_shift_m (20 µm): with the refit of docs/accuracy.md item 13 it reads
+// under it, the unloaded-stick rule covers this grasp too and both variants end 0.88 mm off.
+// The test pins the minimum shift at 10 µm so that the bound alone is what it measures.
 TEST(Accuracy, AFlatFaceFirstSeenAtACornerIsNotReadAsATranslation) {
-  const tacse3::config::CalibrationSet committed = committed_calibration();
+  tacse3::config::CalibrationSet committed = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
+  for (auto& s : committed.sensor) s.slip_min_shift_m = 10e-6;
   const tt::SimCase c = sim_case("textured-cube", "tx", 10.0, 2, 0.0);
   tacse3::config::CalibrationSet off = committed;
   for (auto& s : off.sensor) s.max_mask_area_ratio = 1e4;
@@ -440,6 +444,33 @@ TEST(Accuracy, AReleasedGraspKeepsThePoseItHeld) {
   EXPECT_GT(rx_off.final_rotation_error_deg, 1.0);
   EXPECT_LT(ty_on.final_translation_error_mm, 0.2);
   EXPECT_LT(ty_on.final_rotation_error_deg, 0.5);
+}
+
+// Every axis a recording turns about is fitted for the proxy that explains it, down to a 1 deg
+// stick motion (tacse3-calibrate, docs/calibration.md stage 2). With a 3 deg floor the only
+// stick recording about y (2 deg) left the displacement proxy's y scale to the velocity proxy's
+// fit on the slide, and a stick about y read over.
+TEST(Accuracy, ATwoDegreeStickRotationFitsItsAxisForTheDisplacementProxy) {
+  const std::vector<tt::SimCase> cal = {short_case("sphere", "ry", 30, 7, 18),
+                                        short_case("sphere", "rx", 3, 7, 18),
+                                        short_case("sphere", "ry", 2, 7, 18)};
+  tt::CalibrateOptions co;
+  co.jobs = 2;
+  tt::CalibrateReport rep;
+  const std::string e = tt::calibrate_cases(cal, co, &rep);
+  ASSERT_TRUE(e.empty()) << e;
+  std::printf("%s", tt::format_report(rep).c_str());
+  ASSERT_EQ(rep.recordings.size(), 3u);
+  EXPECT_EQ(rep.recordings[0].explained_by, tt::ProxyMode::kVelocity);
+  EXPECT_EQ(rep.recordings[2].explained_by, tt::ProxyMode::kDisplacement);
+  for (const std::string& n : rep.notes)
+    EXPECT_EQ(n.find("rotates about y"), std::string::npos) << n;
+  // A stick about y on another seed and size, with the defaults (joint, auto).
+  const tt::PoseErrors ry = replay_errors(short_case("sphere", "ry", 2, 1, 20), rep.calibration);
+  std::printf("sphere ry 2 deg (seed 1, radius 20 mm): %.2f deg, error %.2f deg\n",
+              ry.estimated_rotation_deg, ry.final_rotation_error_deg);
+  // 0.08 deg measured; 0.12 deg with the y scale taken from the slide (the 3 deg floor).
+  EXPECT_LT(ry.final_rotation_error_deg, 0.10);
 }
 
 }  // namespace
