@@ -196,6 +196,8 @@ void MotionEstimator::reset_detector() noexcept {
 }
 
 void MotionEstimator::reset() noexcept {
+  anchor_mask_.fill(0);
+  have_anchor_ = false;
   prev_mask_.fill(0);
   prev_x_nm_.fill(0);
   prev_y_nm_.fill(0);
@@ -229,8 +231,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // with a shear increment: a cell that (re-)enters Ω was usually not tracked by the flow while
   // it was out, holds a stale shear, and its first increment would be the whole catch-up at the
   // patch rim (docs/accuracy.md: an uncalibrated sphere rz 4° stick read as 6.84°).
-  ContactMoments m, m_stayed;
-  ProxySums sum_shear, sum_increment;
+  ContactMoments m, m_stayed, m_anchored;
+  ProxySums sum_shear, sum_increment, sum_anchored;
   const auto add_point = [](ContactMoments& c, std::int64_t x, std::int64_t y, std::int64_t z) {
     ++c.n;
     c.sx += x;
@@ -262,6 +264,10 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       }
       add_point(m_stayed, x, y, z);
       sum_increment.add(x, y, z, dx, dy);
+      if (have_anchor_ && anchor_mask_.v[i] != 0) {
+        add_point(m_anchored, x, y, z);
+        sum_anchored.add(x, y, z, dx, dy);
+      }
       ++common;
       common_dx += x - clamp64(prev_x_nm_.v[i], -kMaxPointNm, kMaxPointNm);
       common_dy += y - clamp64(prev_y_nm_.v[i], -kMaxPointNm, kMaxPointNm);
@@ -275,6 +281,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   sum_shear.store(mv);
   ContactMoments mi = m_stayed;
   sum_increment.store(mi);
+  ContactMoments ma = m_anchored;
+  sum_anchored.store(ma);
 
   // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
   // and its relative rate of fall ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) · Δt), EMA the
@@ -304,6 +312,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // --- kAuto: the stick/slip detector on the rigid-body content of the shear and its increment.
   // The proxy of this frame is the one decided up to the previous frame.
   const bool sticking = automatic ? !slipping_ : mode_ == VelocityProxy::kDisplacement;
+  bool slide_ended = false;
   if (automatic) {
     if (m.n == 0) {
       reset_detector();  // no contact: the next contact starts sticking (static friction first)
@@ -359,6 +368,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
           // The slide is over and the gel has relaxed: stick again from here (increments only,
           // so the residual shear does not move the pose).
           reset_detector();
+          slide_ended = true;
         }
       }
     }
@@ -366,8 +376,13 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   }
 
   // Final proxy of this frame, and (kAuto while sticking) the velocity proxy's reading beside it.
+  // The displacement proxy reads its increments over the anchored patch: a tangential load
+  // stretches the gel behind the patch, 𝒢 reads the stretch as normal load and Ω grows over gel
+  // that does not move with the object (a 4° stick rotation of a sphere about x: 110 cells
+  // before the motion, 315 after), which diluted the mean increment more the larger the motion
+  // (docs/dsp.md §4.2c). Over Ω_t ∩ Ω_{t−1} alone if the anchor and Ω no longer share a cell.
   out.velocity_differs = automatic && sticking;
-  out.moments = sticking ? mi : mv;
+  out.moments = sticking ? (ma.n > 0 ? ma : mi) : mv;
   // A sticking contact whose load falls faster than release_load_rate is being let go: the
   // displacement proxy's increments are the gel springing back, not the object, so this frame's
   // chosen reading is dropped (rotation and translation; the velocity reading beside it stays).
@@ -378,11 +393,11 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
 
   // --- translation: contact-centroid planar displacement (paper Sec. IV-D), t_z = 0.
   if (m.n > 0) {
-    out.centroid_m = Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sx),
-                                                     static_cast<double>(m.sy),
-                                                     static_cast<double>(m.sz)) *
-                                     kNm) /
-                     static_cast<double>(m.n);
+    out.centroid_m =
+        Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sx), static_cast<double>(m.sy),
+                                        static_cast<double>(m.sz)) *
+                        kNm) /
+        static_cast<double>(m.n);
   }
   // The sliding rule's centroid is weighted by the contact points' height z (the indentation
   // estimate): cells at the rim of Ω carry z ≈ 0, so the cells that flicker in and out of Ω
@@ -390,11 +405,11 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // (docs/accuracy.md item 5). Without any height (flat contact, height_gain 0) the plain mean.
   const bool weighted = m.sz > 0 && prev_sz_ > 0;
   const Eigen::Vector3d slide_point =
-      weighted ? Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sxz),
-                                                 static_cast<double>(m.syz),
-                                                 static_cast<double>(m.szz)) *
-                                 kNm / static_cast<double>(m.sz))
-               : out.centroid_m;
+      weighted
+          ? Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sxz), static_cast<double>(m.syz),
+                                            static_cast<double>(m.szz)) *
+                            kNm / static_cast<double>(m.sz))
+          : out.centroid_m;
   out.translation_point_m = out.centroid_m;
   const std::int64_t uni = m.n + prev_count_ - common;
   out.mask_change = uni > 0 ? 1.0 - static_cast<double>(common) / static_cast<double>(uni) : 1.0;
@@ -500,7 +515,18 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     out.velocity_translation_point_m = out.translation_point_m;
   }
 
-  // --- state for the next frame.
+  // --- state for the next frame. The anchor follows Ω while the contact is tangentially
+  // unloaded (the grasp: a few µm of planar shear content), from its first frame, and from the
+  // frame a slide ended (the patch is where the slide left it); it stays while a tangential load
+  // is held.
+  if (m.n == 0) {
+    have_anchor_ = false;
+  } else if (!have_anchor_ || slide_ended ||
+             planar_content(mv, c_displacement_ * kQ16Lsb).norm() <= min_shift_m_) {
+    anchor_mask_ = contact.mask;
+    have_anchor_ = true;
+    out.anchor_set = true;
+  }
   prev_mask_ = contact.mask;
   prev_x_nm_ = contact.x_nm;
   prev_y_nm_ = contact.y_nm;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -371,6 +372,107 @@ TEST(Motion, DisplacementIncrementsOnlyFromCellsInBothMasks) {
   EXPECT_EQ(m.moments.n, both);  // the proxy's moments: the cells in both masks
   ASSERT_TRUE(m.rotation_valid);
   EXPECT_NEAR(m.omega.z(), 0.5, 1e-4);
+}
+
+// A held tangential load stretches the gel behind the patch, and 𝒢 reads the stretch as normal
+// load: Ω grows over gel that follows the object only partly (the simulator's sphere rx 4°
+// stick: 110 cells before the motion, 315 after). The displacement proxy reads its increments
+// over the patch as it was while the contact was tangentially unloaded (docs/dsp.md §4.2c).
+// Here: an unloaded patch of radius 3 mm, then a torsion that grows Ω to 4.5 mm, the ring
+// gaining half the rigid increment. The anchored reading is the rigid torsion; over the whole
+// Ω_t ∩ Ω_{t−1} the ring would dilute it. Fixed path and double reference alike.
+TEST(Motion, AHeldTangentialLoadIsReadOverThePatchNotTheStretchedGel) {
+  Calibration cal;
+  cal.velocity_proxy = VelocityProxy::kDisplacement;
+  cal.solve_lambda_rel = 0.0;
+  cal.solve_lever_floor_m = 0.0;
+  RigidContactScene small, large;
+  small.radius_m = 3e-3;
+  large.radius_m = 4.5e-3;
+  small.omega_G = large.omega_G = Eigen::Vector3d(0.0, 0.0, 3.0);
+  const SyntheticSensorFrames fs = dsp_ref::render_rigid_contact(cal, small);
+  const SyntheticSensorFrames fl = dsp_ref::render_rigid_contact(cal, large);
+  // Per-cell rigid increment of one frame (Q16 shear units) at the large patch's cells.
+  VectorField inc;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+    inc.x.v[i] = fl.shear_now.x.v[i] - fl.shear_prev.x.v[i];
+    inc.y.v[i] = fl.shear_now.y.v[i] - fl.shear_prev.y.v[i];
+  }
+  VectorField zero;
+  zero.x.fill(0);
+  zero.y.fill(0);
+
+  Runner run(cal);
+  const SensorMotion a = run.frame(fs.fz, fs.w_now, zero);  // the grasp: no tangential load
+  EXPECT_TRUE(a.anchor_set);
+  const GridMask patch = run.cs->mask;
+  std::array<GridMask, 3> masks{patch, {}, {}};
+  // Frame b: Ω grows to the large patch; every cell gains its increment, the ring half of it.
+  auto s1 = std::make_unique<VectorField>(zero);
+  const auto add_increment = [&](VectorField& s) {
+    for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+      const int k = patch.v[i] != 0 ? 2 : 1;
+      s.x.v[i] += inc.x.v[i] * k / 2;
+      s.y.v[i] += inc.y.v[i] * k / 2;
+    }
+  };
+  add_increment(*s1);
+  const SensorMotion b = run.frame(fl.fz, fl.w_now, *s1);
+  EXPECT_FALSE(b.anchor_set) << "loaded: |X| above slip_min_shift_m";
+  masks[1] = run.cs->mask;
+  int ring = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i)
+    ring += run.cs->mask.v[i] != 0 && patch.v[i] == 0 ? 1 : 0;
+  ASSERT_GT(ring, 20);
+  auto s2 = std::make_unique<VectorField>(*s1);
+  add_increment(*s2);
+  const SensorMotion c = run.frame(fl.fz, fl.w_now, *s2);
+  ASSERT_TRUE(c.rotation_valid);
+  masks[2] = run.cs->mask;
+  int in_patch = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i)
+    in_patch += run.cs->mask.v[i] != 0 && patch.v[i] != 0 ? 1 : 0;
+  EXPECT_EQ(c.moments.n, in_patch);
+  EXPECT_NEAR(c.omega.z(), 3.0, 3e-3);
+  // What Ω_t ∩ Ω_{t−1} would read: the rigid fit of the same increments with the ring's halved.
+  double num = 0.0, den = 0.0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+    if (run.cs->mask.v[i] == 0) continue;
+    const double x = run.cs->x_nm.v[i] * 1e-9, y = run.cs->y_nm.v[i] * 1e-9;
+    const double k = patch.v[i] != 0 ? 1.0 : 0.5;
+    num += k * 3.0 * (x * x + y * y);
+    den += x * x + y * y;
+  }
+  std::printf("anchored torsion %.4f rad/s for 3; over all of Omega %.3f\n", c.omega.z(),
+              num / den);
+  EXPECT_LT(num / den, 2.5);
+
+  // The double reference, on the same masks, takes the same anchor.
+  dsp_ref::ContactDetectorRef rdet(cal);
+  dsp_ref::MotionRef rme(cal);
+  auto shear_d = [](const VectorField& s, bool x) {
+    std::vector<double> v(static_cast<std::size_t>(kGridCount));
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = from_q<16>(x ? s.x.v[i] : s.y.v[i]);
+    return v;
+  };
+  auto fz_d = [](const ScalarField& f) {
+    std::vector<double> v(static_cast<std::size_t>(kGridCount));
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = from_q<16>(f.v[i]);
+    return v;
+  };
+  const dsp_ref::SensorMotionRef ra =
+      rme.update(rdet.detect(fz_d(fs.fz), fs.w_now, fs.valid, &masks[0]), shear_d(zero, true),
+                 shear_d(zero, false), kDt);
+  EXPECT_TRUE(ra.anchor_set);
+  const dsp_ref::SensorMotionRef rb =
+      rme.update(rdet.detect(fz_d(fl.fz), fl.w_now, fl.valid, &masks[1]), shear_d(*s1, true),
+                 shear_d(*s1, false), kDt);
+  EXPECT_FALSE(rb.anchor_set);
+  const dsp_ref::SensorMotionRef rc =
+      rme.update(rdet.detect(fz_d(fl.fz), fl.w_now, fl.valid, &masks[2]), shear_d(*s2, true),
+                 shear_d(*s2, false), kDt);
+  EXPECT_EQ(static_cast<int>(rc.samples.size()), in_patch);
+  EXPECT_NEAR(rc.omega.z(), c.omega.z(), 1e-3);
 }
 
 // rotation_scale serves the velocity proxy; the displacement proxy's frames use rotation_scale

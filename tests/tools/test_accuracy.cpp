@@ -449,7 +449,7 @@ TEST(Accuracy, AReleasedGraspKeepsThePoseItHeld) {
 // Every axis a recording turns about is fitted for the proxy that explains it, down to a 1 deg
 // stick motion (tacse3-calibrate, docs/calibration.md stage 2). With a 3 deg floor the only
 // stick recording about y (2 deg) left the displacement proxy's y scale to the velocity proxy's
-// fit on the slide, and a stick about y read over.
+// fit on the slide (the report's note says so), and a stick about y read over.
 TEST(Accuracy, ATwoDegreeStickRotationFitsItsAxisForTheDisplacementProxy) {
   const std::vector<tt::SimCase> cal = {short_case("sphere", "ry", 30, 7, 18),
                                         short_case("sphere", "rx", 3, 7, 18),
@@ -469,7 +469,9 @@ TEST(Accuracy, ATwoDegreeStickRotationFitsItsAxisForTheDisplacementProxy) {
   const tt::PoseErrors ry = replay_errors(short_case("sphere", "ry", 2, 1, 20), rep.calibration);
   std::printf("sphere ry 2 deg (seed 1, radius 20 mm): %.2f deg, error %.2f deg\n",
               ry.estimated_rotation_deg, ry.final_rotation_error_deg);
-  // 0.08 deg measured; 0.12 deg with the y scale taken from the slide (the 3 deg floor).
+  // 0.05 deg measured. With the 3 deg floor the note above fails the test; the reading itself
+  // was 0.12 deg then, and is 0.01 deg since the displacement proxy reads the anchored patch
+  // (docs/dsp.md §4.2c), so this bound alone no longer tells the two floors apart.
   EXPECT_LT(ry.final_rotation_error_deg, 0.10);
 }
 

@@ -86,6 +86,8 @@ void MotionRef::reset_detector() {
 void MotionRef::reset() {
   const auto n = static_cast<std::size_t>(dsp::kGridCount);
   prev_mask_.assign(n, 0);
+  anchor_.assign(n, 0);
+  have_anchor_ = false;
   prev_q_.assign(n, Eigen::Vector3d::Zero());
   prev_sx_.assign(n, 0.0);
   prev_sy_.assign(n, 0.0);
@@ -111,6 +113,12 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       evidence_frames_ = 0;
     } else {
       reset_detector();
+      // dsp::MotionEstimator set its anchor to Ω at the end of the frame the slide ended.
+      if (!release_follow->has_anchor &&
+          std::find(prev_mask_.begin(), prev_mask_.end(), 1) != prev_mask_.end()) {
+        anchor_ = prev_mask_;
+        have_anchor_ = true;
+      }
     }
   }
   int prev_count = 0, common = 0;
@@ -120,7 +128,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   double z_now = 0.0, z_prev = 0.0;
   Eigen::Vector3d sum_common = Eigen::Vector3d::Zero();
   // Per point: shear (velocity reading), increment (displacement reading).
-  std::vector<PointSample> shear_pts, incr_pts;
+  std::vector<PointSample> shear_pts, incr_pts, anchored_pts;
   for (std::size_t i = 0; i < n; ++i) {
     if (prev_mask_[i] != 0) {
       ++prev_count;
@@ -142,6 +150,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     if (stayed) {
       s.v = dv;
       incr_pts.push_back(s);
+      if (have_anchor_ && anchor_[i] != 0) anchored_pts.push_back(s);
     }
     sum_now += s.q;
     zsum_now += s.q.z() * s.q;
@@ -173,32 +182,34 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   const bool release_rule = cal_.release_load_rate < dsp::kReleaseRuleOff;
   const bool unloading_fast = release_rule && out.load_drop_rate > cal_.release_load_rate;
 
+  // Planar rigid-body content of the shear read as a contact displacement (brute force).
+  auto planar = [&](const std::vector<PointSample>& pts) -> Eigen::Vector3d {
+    if (pts.empty()) return Eigen::Vector3d::Zero();
+    const double k = static_cast<double>(pts.size());
+    Eigen::Vector3d cen = Eigen::Vector3d::Zero();
+    for (const auto& p : pts) cen += p.q;
+    cen /= k;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    double torque = 0.0, inertia = 0.0;
+    for (const auto& p : pts) {
+      const Eigen::Vector2d r = (p.q - cen).head<2>();
+      const Eigen::Vector2d v = cal_.c_displacement * p.v.head<2>();
+      mean += v;
+      torque += r.x() * v.y() - r.y() * v.x();
+      inertia += r.squaredNorm();
+    }
+    mean /= k;
+    return {inertia > 0.0 ? torque / std::sqrt(k * inertia) : 0.0, mean.x(), mean.y()};
+  };
   const bool sticking =
       automatic ? !slipping_ : cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
+  bool slide_ended = false;
+  const double anchor_shift = planar(shear_pts).norm();  // |X| unsmoothed, for the anchor rule
   if (automatic) {
     if (out.points == 0) {
       reset_detector();
     } else {
-      // Planar rigid-body content of the shear read as a contact displacement (brute force):
       // X over Ω, its change over Ω_t ∩ Ω_{t−1} (the increments), both smoothed.
-      auto planar = [&](const std::vector<PointSample>& pts) -> Eigen::Vector3d {
-        if (pts.empty()) return Eigen::Vector3d::Zero();
-        const double k = static_cast<double>(pts.size());
-        Eigen::Vector3d cen = Eigen::Vector3d::Zero();
-        for (const auto& p : pts) cen += p.q;
-        cen /= k;
-        Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-        double torque = 0.0, inertia = 0.0;
-        for (const auto& p : pts) {
-          const Eigen::Vector2d r = (p.q - cen).head<2>();
-          const Eigen::Vector2d v = cal_.c_displacement * p.v.head<2>();
-          mean += v;
-          torque += r.x() * v.y() - r.y() * v.x();
-          inertia += r.squaredNorm();
-        }
-        mean /= k;
-        return {inertia > 0.0 ? torque / std::sqrt(k * inertia) : 0.0, mean.x(), mean.y()};
-      };
       const Eigen::Vector3d raw = planar(shear_pts);
       const Eigen::Vector3d step = planar(incr_pts);
       const double alpha = cal_.slip_smoothing_s > 0.0 ? dt / (cal_.slip_smoothing_s + dt) : 1.0;
@@ -237,7 +248,10 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
         }
       } else {
         peak_shift_m_ = std::max(peak_shift_m_, out.shear_shift_m);
-        if (rest && out.shear_shift_m <= cal_.slip_exit_fraction * peak_shift_m_) reset_detector();
+        if (rest && out.shear_shift_m <= cal_.slip_exit_fraction * peak_shift_m_) {
+          reset_detector();
+          slide_ended = true;
+        }
       }
     }
     out.slipping = !sticking;
@@ -250,7 +264,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   out.velocity_differs = automatic && sticking;
   for (auto& p : shear_pts) p.v *= cal_.c_velocity;
   if (sticking) {
-    out.samples = incr_pts;
+    // Increments over the anchored patch (dsp::MotionEstimator's rule), Ω_t ∩ Ω_{t−1} if none.
+    out.samples = anchored_pts.empty() ? incr_pts : anchored_pts;
     for (auto& p : out.samples) p.v *= have_prev_shear_ ? cal_.c_displacement / dt : 0.0;
   } else {
     out.samples = shear_pts;
@@ -329,6 +344,15 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     out.velocity_translation = out.translation;
     out.velocity_translation_valid = out.translation_valid;
     out.velocity_translation_point = out.translation_point;
+  }
+  if (out.points == 0) {
+    have_anchor_ = false;
+  } else if (release_follow != nullptr && release_follow->has_anchor
+                 ? release_follow->anchor_set
+                 : (!have_anchor_ || slide_ended || anchor_shift <= cal_.slip_min_shift_m)) {
+    anchor_ = c.mask;
+    have_anchor_ = true;
+    out.anchor_set = true;
   }
   prev_mask_ = c.mask;
   prev_q_ = c.q;

@@ -110,6 +110,11 @@ struct SensorMotion {
   // false, ω = 0). The velocity reading beside it (kAuto) is kept: it only counts if a slide is
   // detected afterwards (the payback's deficit), and a releasing frame may be a slide's.
   bool releasing = false;
+  // The displacement proxy's patch anchor was set to this frame's Ω (every mode): the contact's
+  // first frame, a tangentially unloaded shear (|X| ≤ slip_min_shift_m, X over Ω unsmoothed),
+  // or the frame a slide ended. Increments are read over Ω_t ∩ Ω_{t−1} ∩ anchor (docs/dsp.md
+  // §4.2c).
+  bool anchor_set = false;
   // --- the same frame as kVelocity would have read it: the velocity proxy's moments and ω, and
   // the sliding translation rule. Differs from the reading above only while kAuto sticks
   // (velocity_differs); otherwise a copy of it. The dual pipeline fuses both readings and pays
@@ -204,6 +209,12 @@ class MotionEstimator {
   std::int64_t prev_syz_ = 0;  // Σ y z
   VectorField prev_shear_;
   bool have_prev_shear_ = false;
+  // The contact patch as of the last frame its shear was tangentially unloaded (|X| ≤
+  // slip_min_shift_m), or its first frame, or the frame a slide ended: the cells the displacement
+  // proxy reads increments from. A tangential load stretches the gel behind the patch, which
+  // 𝒢 reads as normal load, so Ω grows over gel that does not move with the object.
+  GridMask anchor_mask_;
+  bool have_anchor_ = false;
 
   // --- kAuto detector (Calibration fields of the same names).
   double relax_rate_on_ = 0.0;

@@ -46,8 +46,8 @@ struct SensorMotionRef {
   Eigen::Vector3d translation_point = Eigen::Vector3d::Zero();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();  // scaled, t_z = 0
   bool translation_valid = false;
-  int translation_source = 0;                       // as dsp::TranslationSource
-  Eigen::Vector3d omega = Eigen::Vector3d::Zero();  // scaled, own-frame stacked LS
+  int translation_source = 0;                                // as dsp::TranslationSource
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero();           // scaled, own-frame stacked LS
   Eigen::Vector3d rotation_scale = Eigen::Vector3d::Ones();  // this frame's proxy's scales
   bool proxy_valid = false;
   // kAuto detector, as dsp::SensorMotion.
@@ -58,7 +58,8 @@ struct SensorMotionRef {
   double shear_shift_m = 0.0;
   double shear_rate_m_s = 0.0;
   double load_drop_rate = 0.0;
-  bool releasing = false;  // as dsp::SensorMotion::releasing (the chosen reading is dropped)
+  bool releasing = false;   // as dsp::SensorMotion::releasing (the chosen reading is dropped)
+  bool anchor_set = false;  // as dsp::SensorMotion::anchor_set (the patch anchor is this Ω)
   // The frame as kVelocity would have read it (dsp::SensorMotion's velocity_* fields).
   bool velocity_differs = false;
   std::vector<PointSample> velocity_samples;
@@ -74,13 +75,17 @@ struct SensorMotionRef {
 // proxy that frame used, `slip_onset` whether the detector switched to slip at its end,
 // `stick_confirmed` whether it confirmed a stick (the dual pipeline's slip payback reads both),
 // `releasing` whether the frame's chosen reading was dropped as a release (load falling faster
-// than release_load_rate). Used ONLY to measure the numeric fixed−ref difference with the
+// than release_load_rate), `anchor_set` (if `has_anchor`) whether the displacement proxy's patch
+// anchor was set to the frame's Ω (every mode; without `has_anchor` the reference decides). Used
+// ONLY to measure the numeric fixed−ref difference with the
 // detector's threshold crossings taken out ("decision-locked"; docs/dsp.md).
 struct SlipDecision {
   bool slipping = false;
   bool stick_confirmed = false;
   bool slip_onset = false;
   bool releasing = false;
+  bool has_anchor = false;
+  bool anchor_set = false;
 };
 
 // Same rules as dsp::MotionEstimator (translation sources, proxy modes, λ), in double.
@@ -102,6 +107,9 @@ class MotionRef {
   std::vector<Eigen::Vector3d> prev_q_;
   std::vector<double> prev_sx_, prev_sy_;
   bool have_prev_shear_ = false;
+  // The displacement proxy's patch anchor (dsp::MotionEstimator's rule).
+  std::vector<std::uint8_t> anchor_;
+  bool have_anchor_ = false;
   // kAuto detector state (dsp::MotionEstimator's, in double).
   bool slipping_ = false;
   int evidence_frames_ = 0;

@@ -28,7 +28,7 @@ class DecisionFollower {
   explicit DecisionFollower(const Levels& levels) : levels_(levels) {}
 
   const std::array<dsp_ref::FixedDecisions, 2>& take(const dsp::DualPipeline& pipeline,
-                                                    const dsp::DualResult& result) {
+                                                     const dsp::DualResult& result) {
     for (std::size_t s = 0; s < 2; ++s) {
       const dsp::SensorResult& r = result.sensors[s];
       const dsp::SensorPipeline& sp = pipeline.sensor(static_cast<dsp::SensorSlot>(s));
@@ -37,6 +37,8 @@ class DecisionFollower {
       slip_[s].stick_confirmed = r.motion.stick_confirmed;
       slip_[s].slip_onset = r.motion.slip_onset;
       slip_[s].releasing = r.motion.releasing;
+      slip_[s].has_anchor = true;
+      slip_[s].anchor_set = r.motion.anchor_set;
       dsp_ref::FixedDecisions& d = out_[s];
       d.slip = levels_.slip ? &slip_[s] : nullptr;
       d.flow.valid = levels_.flow ? &f.flow_valid : nullptr;
