@@ -305,9 +305,9 @@ TEST_F(EngineTest, BothSensorsLostIsAFault) {
 }
 
 // The two pads of one board go a few ms apart (a sysfs unbind removes them one after the other)
-// with no cycle in between: the DEGRADED Status goes out for the first, and the FAULT for the
-// second must not wait for the next 10 Hz group (up to 100 ms) because "one change-triggered
-// Status per cycle" had no cycle left to count. With no cycle running, one per frame period.
+// with no cycle in between, here after the stream has already stopped for two frame periods and
+// the last cycle's slot went to the 10 Hz group: before, neither change went out until the next
+// group (up to 100 ms). With no cycle running, one change Status per frame period.
 TEST_F(EngineTest, SecondSensorLostWithoutACycleBetweenIsReportedAtOnce) {
   // 13 ticks: the last one (at 100.5 ms) carries the periodic group, the next is due at 200 ms.
   for (std::size_t i = 0; i < 13; ++i) tick(i);
@@ -343,6 +343,39 @@ TEST_F(EngineTest, SecondSensorLostWithoutACycleBetweenIsReportedAtOnce) {
   EXPECT_EQ(b.statuses.back().health_left, protocol::SensorHealth::kLost);
   // Two Status frames in the window, not one per step.
   EXPECT_EQ(b.statuses.size(), statuses_before + 2);
+}
+
+// The case of the VM's sysfs unbind: the first pad's loss goes out in the last cycle's own slot
+// (no periodic group in it), then the second pad goes 3 ms later with no cycle after it. Before,
+// that FAULT waited for the 10 Hz group (up to 100 ms, 105 ms measured under TCG).
+TEST_F(EngineTest, FaultAfterADegradedStatusInTheLastCyclesSlotIsNotHeld) {
+  // 14 ticks: the group went out with tick 12 (at 100.5 ms), tick 13 (108.8 ms) has its slot free.
+  for (std::size_t i = 0; i < 14; ++i) tick(i);
+  const std::int64_t t_last = now_;
+  const std::uint64_t groups = engine_->stats().status_groups;
+  const auto statuses_before = decode().statuses.size();
+  std::int64_t t_degraded = -1;
+  std::int64_t t_fault = -1;
+  for (std::int64_t t = t_last + 2'000'000; t < t_last + 60'000'000; t += 1'000'000) {
+    if (t == t_last + 2'000'000) shared_.sensors[0].disconnected.store(true);
+    if (t == t_last + 5'000'000) shared_.sensors[1].disconnected.store(true);
+    engine_->step(t);
+    const auto b = decode();
+    if (b.statuses.size() == statuses_before) continue;
+    const protocol::State st = b.statuses.back().state;
+    if (st == protocol::State::kDegradedSingleSensor && t_degraded < 0) t_degraded = t;
+    if (st == protocol::State::kFault) {
+      t_fault = t;
+      break;
+    }
+  }
+  ASSERT_EQ(engine_->stats().status_groups, groups) << "a periodic group fell in the window";
+  EXPECT_EQ(t_degraded, t_last + 2'000'000) << "in the last cycle's slot";
+  ASSERT_GE(t_fault, 0) << "no FAULT Status within 60 ms of the second loss";
+  // Two frame periods after the last cycle (the stream has stopped), not at the group 90 ms on.
+  EXPECT_GE(t_fault - t_last, 2 * kPeriod);
+  EXPECT_LE(t_fault - t_last, 2 * kPeriod + 1'000'000);
+  EXPECT_EQ(decode().statuses.size(), statuses_before + 2);
 }
 
 // A slow core with a backlog of frames must not hold the 10 Hz Status back: one step processes

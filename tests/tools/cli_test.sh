@@ -50,12 +50,14 @@ check "no arguments is an error" test $? -ne 0
 
 # --slip-log on a grasp that ends with the pads opening over 0.2 s (docs/replay.md, dsp.md 4.2b):
 # one row per present sensor and frame; 'releasing' only within the release, and there with a
-# load falling faster than the default release_load_rate (4/s); a 2 deg stick motion never slips.
+# load falling faster than the default release_load_rate (4/s: a consistency check of the two
+# columns, since that is the rule's definition); a 2 deg stick motion never slips.
 "$SIM" -q --out "$T/rel" --object sphere --motion rz --magnitude 2 --colour grey \
   --approach-s 0.05 --grasp-s 0.2 --settle-s 0.05 --hold-s 0.1 --release-s 0.2 ||
   { echo "FAIL tacse3-sim --release-s"; exit 1; }
 rel_frames=$(($(wc -l < "$T/rel/frames.csv") - 1))
-t_release=$(tail -1 "$T/rel/frames.csv" | awk -F, '{ print $2 - 200000000 }')
+# The release starts 0.2 s before the recording's end, one frame period after its last frame.
+t_release=$(tail -1 "$T/rel/frames.csv" | awk -F, '{ print $2 + 8333333 - 200000000 }')
 "$REPLAY" "$T/rel" --out "$T/rel.csv" --slip-log "$T/slip.csv" -q
 check "replay --slip-log exits 0" test $? -eq 0
 check "slip log header" test "$(head -1 "$T/slip.csv")" = \

@@ -679,9 +679,12 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     for (int ax = 0; ax < 3; ++ax) {
       const auto a = static_cast<std::size_t>(ax);
       if (!fit.excited[a] || fit.own_axis[static_cast<std::size_t>(m)][a]) continue;
-      rep.notes.push_back(std::string("no recording explained by the ") + to_string(mode_of(m)) +
-                          " proxy rotates about " + "xyz"[ax] +
-                          " by 1 deg or more: its scale there is the other proxy's");
+      char floor[16];
+      std::snprintf(floor, sizeof(floor), "%.0f", kExciteFloorRad * kDeg);
+      rep.notes.push_back(std::string("the ") + to_string(mode_of(m)) + " proxy's " + "xyz"[ax] +
+                          " scale is the other proxy's: none of its recordings rotates about " +
+                          "xyz"[ax] + " by " + floor +
+                          " deg or more, or their readings there do not fit one");
     }
   }
   for (std::size_t r = 0; r < n; ++r) {

@@ -65,7 +65,9 @@ struct EngineConfig {
   // processed cycle. When the stream has stopped (no cycle for two periods: both pads gone), a
   // change goes out once a period has passed since the last Status, instead of waiting for the
   // next 10 Hz group; it fills a cycle slot that stayed empty, so the budget of one Status per
-  // frame period holds (docs/can-protocol.md).
+  // frame period holds on average (docs/can-protocol.md). The configured rate: a camera that
+  // grants less (60 of 120 fps) makes every gap between two cycles "stopped", which allows one
+  // more Status per cycle, within the same budget in Status frames per second.
   std::int64_t frame_period_ns = 8'333'333;  // 120 Hz
 };
 
