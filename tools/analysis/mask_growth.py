@@ -10,27 +10,12 @@ the mask grows over gel that does not move with the object, and a mean over it i
 
 Usage: mask_growth.py DUMP_DIR RECORDING_DIR
 """
-import array
-import ast
 import csv
-import struct
+import os
 import sys
 
-CELLS = 40 * 30
-
-
-def load_npy(path):
-    data = open(path, "rb").read()
-    if data[:6] != b"\x93NUMPY":
-        sys.exit(f"{path}: not a .npy file")
-    header_len = struct.unpack("<H", data[8:10])[0]
-    header = ast.literal_eval(data[10:10 + header_len].decode("latin1"))
-    codes = {"<f4": "f", "|u1": "B", "<u1": "B", "<i8": "q"}
-    if header["descr"] not in codes or header["fortran_order"]:
-        sys.exit(f"{path}: unsupported dtype {header['descr']}")
-    values = array.array(codes[header["descr"]])
-    values.frombytes(data[10 + header_len:])
-    return values, header["shape"]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from torsion_increments import CELLS, load_npy  # noqa: E402
 
 
 def motion_start(recording):
