@@ -122,6 +122,35 @@ class EngineTest : public ::testing::Test {
     return b;
   }
 
+  // Steps every ms from first_ms after the last cycle (now_); the left pad is lost at first_ms,
+  // the right at second_ms. Times relative to now_; stops at the FAULT Status or after 60 ms.
+  struct LossTimes {
+    std::int64_t degraded = -1;
+    std::int64_t fault = -1;
+    std::size_t statuses = 0;
+  };
+  LossTimes lose_both_pads(int first_ms, int second_ms) {
+    LossTimes r;
+    const std::int64_t t_last = now_;
+    const std::size_t before = decode().statuses.size();
+    for (int ms = first_ms; ms < 60; ++ms) {
+      if (ms == first_ms) shared_.sensors[0].disconnected.store(true);
+      if (ms == second_ms) shared_.sensors[1].disconnected.store(true);
+      engine_->step(t_last + ms * 1'000'000LL);
+      const auto b = decode();
+      r.statuses = b.statuses.size() - before;
+      if (r.statuses == 0) continue;
+      const protocol::State st = b.statuses.back().state;
+      if (st == protocol::State::kDegradedSingleSensor && r.degraded < 0)
+        r.degraded = ms * 1'000'000LL;
+      if (st == protocol::State::kFault) {
+        r.fault = ms * 1'000'000LL;
+        break;
+      }
+    }
+    return r;
+  }
+
   static inline std::vector<std::vector<std::uint8_t>>* frames_ = nullptr;
   static inline double separation_m_ = 0.0;
   RecordingChannel channel_;
@@ -311,38 +340,21 @@ TEST_F(EngineTest, BothSensorsLostIsAFault) {
 TEST_F(EngineTest, SecondSensorLostWithoutACycleBetweenIsReportedAtOnce) {
   // 13 ticks: the last one (at 100.5 ms) carries the periodic group, the next is due at 200 ms.
   for (std::size_t i = 0; i < 13; ++i) tick(i);
-  const std::int64_t t_last = now_;
-  const auto statuses_before = decode().statuses.size();
   const std::uint64_t groups = engine_->stats().status_groups;
   // The left pad goes 20 ms after the last cycle (two frame periods: the stream has stopped),
-  // the right 1 ms later; the loop steps every ms.
-  std::int64_t t_degraded = -1;
-  std::int64_t t_fault = -1;
-  for (std::int64_t t = t_last + 20'000'000; t < t_last + 60'000'000; t += 1'000'000) {
-    if (t == t_last + 20'000'000) shared_.sensors[0].disconnected.store(true);
-    if (t == t_last + 21'000'000) shared_.sensors[1].disconnected.store(true);
-    engine_->step(t);
-    const auto b = decode();
-    if (b.statuses.size() == statuses_before) continue;
-    const protocol::State st = b.statuses.back().state;
-    if (st == protocol::State::kDegradedSingleSensor && t_degraded < 0) t_degraded = t;
-    if (st == protocol::State::kFault) {
-      t_fault = t;
-      break;
-    }
-  }
+  // the right 1 ms later.
+  const LossTimes r = lose_both_pads(20, 21);
   ASSERT_EQ(engine_->stats().status_groups, groups) << "a periodic group fell in the window";
   // The left's loss at once, the right's one frame period after that, not at the 10 Hz group
   // 80 ms later.
-  EXPECT_EQ(t_degraded, t_last + 20'000'000);
-  ASSERT_GE(t_fault, 0) << "no FAULT Status within 60 ms of the second loss";
-  EXPECT_GE(t_fault - t_degraded, kPeriod);
-  EXPECT_LE(t_fault - t_degraded, kPeriod + 1'000'000);
+  EXPECT_EQ(r.degraded, 20'000'000);
+  ASSERT_GE(r.fault, 0) << "no FAULT Status within 60 ms of the second loss";
+  EXPECT_GE(r.fault - r.degraded, kPeriod);
+  EXPECT_LE(r.fault - r.degraded, kPeriod + 1'000'000);
   const auto b = decode();
   EXPECT_EQ(b.statuses.back().fault, protocol::FaultCode::kBothSensorsLost);
   EXPECT_EQ(b.statuses.back().health_left, protocol::SensorHealth::kLost);
-  // Two Status frames in the window, not one per step.
-  EXPECT_EQ(b.statuses.size(), statuses_before + 2);
+  EXPECT_EQ(r.statuses, 2u) << "two Status frames in the window, not one per step";
 }
 
 // The case of the VM's sysfs unbind: the first pad's loss goes out in the last cycle's own slot
@@ -351,31 +363,15 @@ TEST_F(EngineTest, SecondSensorLostWithoutACycleBetweenIsReportedAtOnce) {
 TEST_F(EngineTest, FaultAfterADegradedStatusInTheLastCyclesSlotIsNotHeld) {
   // 14 ticks: the group went out with tick 12 (at 100.5 ms), tick 13 (108.8 ms) has its slot free.
   for (std::size_t i = 0; i < 14; ++i) tick(i);
-  const std::int64_t t_last = now_;
   const std::uint64_t groups = engine_->stats().status_groups;
-  const auto statuses_before = decode().statuses.size();
-  std::int64_t t_degraded = -1;
-  std::int64_t t_fault = -1;
-  for (std::int64_t t = t_last + 2'000'000; t < t_last + 60'000'000; t += 1'000'000) {
-    if (t == t_last + 2'000'000) shared_.sensors[0].disconnected.store(true);
-    if (t == t_last + 5'000'000) shared_.sensors[1].disconnected.store(true);
-    engine_->step(t);
-    const auto b = decode();
-    if (b.statuses.size() == statuses_before) continue;
-    const protocol::State st = b.statuses.back().state;
-    if (st == protocol::State::kDegradedSingleSensor && t_degraded < 0) t_degraded = t;
-    if (st == protocol::State::kFault) {
-      t_fault = t;
-      break;
-    }
-  }
+  const LossTimes r = lose_both_pads(2, 5);
   ASSERT_EQ(engine_->stats().status_groups, groups) << "a periodic group fell in the window";
-  EXPECT_EQ(t_degraded, t_last + 2'000'000) << "in the last cycle's slot";
-  ASSERT_GE(t_fault, 0) << "no FAULT Status within 60 ms of the second loss";
+  EXPECT_EQ(r.degraded, 2'000'000) << "in the last cycle's slot";
+  ASSERT_GE(r.fault, 0) << "no FAULT Status within 60 ms of the second loss";
   // Two frame periods after the last cycle (the stream has stopped), not at the group 90 ms on.
-  EXPECT_GE(t_fault - t_last, 2 * kPeriod);
-  EXPECT_LE(t_fault - t_last, 2 * kPeriod + 1'000'000);
-  EXPECT_EQ(decode().statuses.size(), statuses_before + 2);
+  EXPECT_GE(r.fault, 2 * kPeriod);
+  EXPECT_LE(r.fault, 2 * kPeriod + 1'000'000);
+  EXPECT_EQ(r.statuses, 2u);
 }
 
 // A slow core with a backlog of frames must not hold the 10 Hz Status back: one step processes
