@@ -378,7 +378,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // Final proxy of this frame, and (kAuto while sticking) the velocity proxy's reading beside it.
   // The displacement proxy reads its increments over the anchored patch: a tangential load
   // stretches the gel behind the patch, 𝒢 reads the stretch as normal load and Ω grows over gel
-  // that does not move with the object (a 4° stick rotation of a sphere about x: 110 cells
+  // that does not move with the object (a 4° stick rotation of a sphere about x: 106 cells
   // before the motion, 315 after), which diluted the mean increment more the larger the motion
   // (docs/dsp.md §4.2c). Over Ω_t ∩ Ω_{t−1} alone if the anchor and Ω no longer share a cell.
   out.velocity_differs = automatic && sticking;

@@ -376,7 +376,7 @@ TEST(Motion, DisplacementIncrementsOnlyFromCellsInBothMasks) {
 
 // A held tangential load stretches the gel behind the patch, and 𝒢 reads the stretch as normal
 // load: Ω grows over gel that follows the object only partly (the simulator's sphere rx 4°
-// stick: 110 cells before the motion, 315 after). The displacement proxy reads its increments
+// stick: 106 cells before the motion, 315 after). The displacement proxy reads its increments
 // over the patch as it was while the contact was tangentially unloaded (docs/dsp.md §4.2c).
 // Here: an unloaded patch of radius 3 mm, then a torsion that grows Ω to 4.5 mm, the ring
 // gaining half the rigid increment. The anchored reading is the rigid torsion; over the whole
