@@ -198,6 +198,10 @@ void MotionEstimator::reset_detector() noexcept {
 void MotionEstimator::reset() noexcept {
   anchor_mask_.fill(0);
   have_anchor_ = false;
+  restart();
+}
+
+void MotionEstimator::restart() noexcept {
   prev_mask_.fill(0);
   prev_x_nm_.fill(0);
   prev_y_nm_.fill(0);

@@ -86,7 +86,7 @@ void SensorPipeline::tare() noexcept {
 }
 
 void SensorPipeline::restart_motion() noexcept {
-  motion_.reset();
+  motion_.restart();
 }
 
 void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& out) noexcept {

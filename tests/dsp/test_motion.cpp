@@ -473,6 +473,31 @@ TEST(Motion, AHeldTangentialLoadIsReadOverThePatchNotTheStretchedGel) {
                  shear_d(*s2, false), kDt);
   EXPECT_EQ(static_cast<int>(rc.samples.size()), in_patch);
   EXPECT_NEAR(rc.omega.z(), c.omega.z(), 1e-3);
+
+  // A gap in the stream or a missed frame (restart()) keeps the anchor: the load is still held
+  // and the stretched Ω is not taken for the patch. The first frame after it has no increment.
+  run.me->restart();
+  const SensorMotion d = run.frame(fl.fz, fl.w_now, *s2);
+  EXPECT_FALSE(d.anchor_set);
+  EXPECT_FALSE(d.proxy_valid);
+  auto s3 = std::make_unique<VectorField>(*s2);
+  add_increment(*s3);
+  const SensorMotion e = run.frame(fl.fz, fl.w_now, *s3);
+  ASSERT_TRUE(e.rotation_valid);
+  EXPECT_EQ(e.moments.n, in_patch);
+  EXPECT_NEAR(e.omega.z(), 3.0, 3e-3);
+  // reset() (tare, degraded frame) forgets it: the next frame anchors the stretched Ω.
+  run.me->reset();
+  EXPECT_TRUE(run.frame(fl.fz, fl.w_now, *s3).anchor_set);
+  auto s4 = std::make_unique<VectorField>(*s3);
+  add_increment(*s4);
+  const SensorMotion g = run.frame(fl.fz, fl.w_now, *s4);
+  ASSERT_TRUE(g.rotation_valid);
+  int all = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i)
+    all += run.cs->mask.v[i] != 0 ? 1 : 0;
+  EXPECT_EQ(g.moments.n, all);
+  EXPECT_NEAR(g.omega.z(), num / den, 0.01);
 }
 
 // rotation_scale serves the velocity proxy; the displacement proxy's frames use rotation_scale

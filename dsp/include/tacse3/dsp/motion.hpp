@@ -177,8 +177,14 @@ class MotionEstimator {
   MotionEstimator() noexcept;  // configured with Calibration{} defaults
   // kBadCalibration (previous configuration kept) if validate(cal) fails.
   Status configure(const Calibration& cal) noexcept;
-  // Forget the previous frame (call on tare and after a gap in the stream).
+  // Forget the previous frame and the patch anchor (call on tare, a degraded frame, a new
+  // configuration).
   void reset() noexcept;
+  // Forget the previous frame but keep the patch anchor (call after a gap in the stream or a
+  // missed frame): a tangential load held across the gap has left the gel stretched, and the
+  // Ω of the next frame would anchor the stretched extent (docs/dsp.md §4.2c). The next frame
+  // without contact, or tangentially unloaded, replaces the anchor as usual.
+  void restart() noexcept;
 
   // contact: this frame's ContactSet; shear: calibrated shear field (Q16 shear units);
   // dt_s: time since the previous frame, finite and in (0, 1] s.

@@ -86,7 +86,8 @@ class SensorPipeline {
   // nothing. Never NaN, never throws.
   void process(const FrameView& frame, double dt_s, SensorResult& out) noexcept;
 
-  // Forget the previous frame's motion state (after a gap in the stream) but keep the reference.
+  // Forget the previous frame's motion state (after a gap in the stream or a missed frame) but
+  // keep the reference and the displacement proxy's patch anchor (MotionEstimator::restart()).
   void restart_motion() noexcept;
 
   const SensorFields& fields() const noexcept { return fields_; }
