@@ -500,6 +500,71 @@ TEST(Motion, AHeldTangentialLoadIsReadOverThePatchNotTheStretchedGel) {
   EXPECT_NEAR(g.omega.z(), num / den, 0.01);
 }
 
+// The anchor's fallback: a contact that has left every anchored cell while loaded (here the
+// patch moves off it in one frame, a tangential load held) is read over Ω_t ∩ Ω_{t−1} rather
+// than from nothing. Fixed path and double reference alike.
+TEST(Motion, AContactThatLeftItsAnchoredCellsIsReadOverTheCellsItKept) {
+  Calibration cal;
+  cal.velocity_proxy = VelocityProxy::kDisplacement;
+  cal.solve_lambda_rel = 0.0;
+  cal.solve_lever_floor_m = 0.0;
+  RigidContactScene first, moved;
+  first.radius_m = moved.radius_m = 2.5e-3;
+  first.contact_centre_G = Eigen::Vector3d(-4e-3, 0.0, 0.0);
+  moved.contact_centre_G = Eigen::Vector3d(4e-3, 0.0, 0.0);
+  moved.omega_G = Eigen::Vector3d(0.0, 0.0, 3.0);
+  const SyntheticSensorFrames fa = dsp_ref::render_rigid_contact(cal, first);
+  const SyntheticSensorFrames fb = dsp_ref::render_rigid_contact(cal, moved);
+  // A held tangential load: a uniform 100 µm shift, 5 times slip_min_shift_m.
+  const std::int32_t load_q16 = to_q32<16>(100e-6 / cal.c_displacement);
+  VectorField zero;
+  zero.x.fill(0);
+  zero.y.fill(0);
+  auto loaded_b = std::make_unique<VectorField>(zero);
+  auto loaded_c = std::make_unique<VectorField>(fb.shear_now);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+    loaded_b->x.v[i] += load_q16;
+    loaded_c->x.v[i] += load_q16;
+  }
+  Runner run(cal);
+  EXPECT_TRUE(run.frame(fa.fz, fa.w_now, zero).anchor_set);
+  const GridMask anchor = run.cs->mask;
+  const SensorMotion b = run.frame(fb.fz, fb.w_now, *loaded_b);
+  EXPECT_FALSE(b.anchor_set);
+  const GridMask mask_b = run.cs->mask;
+  const SensorMotion c = run.frame(fb.fz, fb.w_now, *loaded_c);
+  EXPECT_FALSE(c.anchor_set);
+  int kept = 0, anchored = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+    kept += run.cs->mask.v[i] != 0 && mask_b.v[i] != 0 ? 1 : 0;
+    anchored += run.cs->mask.v[i] != 0 && anchor.v[i] != 0 ? 1 : 0;
+  }
+  ASSERT_EQ(anchored, 0);
+  ASSERT_GT(kept, 20);
+  ASSERT_TRUE(c.rotation_valid);
+  EXPECT_EQ(c.moments.n, kept);
+  EXPECT_NEAR(c.omega.z(), 3.0, 3e-3);
+
+  dsp_ref::ContactDetectorRef rdet(cal);
+  dsp_ref::MotionRef rme(cal);
+  const std::array<const SyntheticSensorFrames*, 3> scenes{&fa, &fb, &fb};
+  const std::array<const VectorField*, 3> shears{&zero, loaded_b.get(), loaded_c.get()};
+  const std::array<GridMask, 3> masks{anchor, mask_b, run.cs->mask};
+  dsp_ref::SensorMotionRef r;
+  for (std::size_t k = 0; k < 3; ++k) {
+    std::vector<double> fz(static_cast<std::size_t>(kGridCount)), sx(fz.size()), sy(fz.size());
+    for (std::size_t i = 0; i < fz.size(); ++i) {
+      fz[i] = from_q<16>(scenes[k]->fz.v[i]);
+      sx[i] = from_q<16>(shears[k]->x.v[i]);
+      sy[i] = from_q<16>(shears[k]->y.v[i]);
+    }
+    r = rme.update(rdet.detect(fz, scenes[k]->w_now, scenes[k]->valid, &masks[k]), sx, sy, kDt);
+    EXPECT_EQ(r.anchor_set, k == 0) << "frame " << k;
+  }
+  EXPECT_EQ(static_cast<int>(r.samples.size()), kept);
+  EXPECT_NEAR(r.omega.z(), c.omega.z(), 1e-3);
+}
+
 // rotation_scale serves the velocity proxy; the displacement proxy's frames use rotation_scale
 // ⊙ displacement_rotation_ratio, and kAuto reports each reading with its own scales.
 TEST(Motion, DisplacementRotationRatioScalesOnlyTheDisplacementProxy) {

@@ -558,6 +558,96 @@ TEST(SlipDetector, NoSlipOnsetWhileTheLoadFallsFasterThanTheReleaseRate) {
   EXPECT_EQ(mr.omega, Eigen::Vector3d::Zero());
 }
 
+// The displacement proxy's patch anchor is set again where a slide ended (docs/dsp.md §4.2c):
+// the patch is where the slide left it, and the friction-held shear left in the gel is no
+// reason to keep the patch of before the slide. Here the grasp is a small disc (anchored, no
+// load), which grows into a large one once a 10 mm slide loads it (the anchor stays on the
+// small one), and the slide ends with a held shift of 100 µm, 5 times slip_min_shift_m. After
+// the slide the increments are read over the large disc. The double reference decides the same,
+// and the decision-locked reference follows the anchor it is given, also when that differs.
+TEST(SlipDetector, ASlideEndsWithThePatchItLeftAnchored) {
+  const Calibration cal = auto_cal();
+  const Disc small(3.0), large(6.0);
+  constexpr int kRest = 12, kSlide = 120, kAfter = 48;
+  const double held_m = 100e-6;
+  struct Frame {
+    const Disc* disc;
+    double tx;
+  };
+  std::vector<Frame> frames;
+  for (int k = 0; k < kRest; ++k) frames.push_back({&small, 0.0});
+  bool loaded = false;
+  for (int k = 0; k <= kSlide; ++k) {
+    const double s = static_cast<double>(k) / kSlide;
+    // Shear ∝ sliding speed (drag) plus the held shift building up over the slide.
+    const double tx = kDragS * 10e-3 * min_jerk_rate(s) + held_m * min_jerk(s);
+    loaded = loaded || tx > 2.0 * cal.slip_min_shift_m;
+    frames.push_back({loaded ? &large : &small, tx});
+  }
+  for (int k = 0; k < kAfter; ++k) frames.push_back({&large, held_m});
+
+  auto me = std::make_unique<MotionEstimator>();
+  ASSERT_EQ(me->configure(cal), Status::kOk);
+  dsp_ref::MotionRef free_ref(cal), locked(cal), other(cal);
+  auto sh = std::make_unique<VectorField>();
+  std::vector<double> sx, sy;
+  std::vector<SensorMotion> fixed;
+  std::vector<dsp_ref::SlipDecision> decisions;
+  int onsets = 0;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    frames[k].disc->shear(0.0, frames[k].tx, cal.c_displacement, *sh, sx, sy);
+    SensorMotion m;
+    ASSERT_EQ(me->update(*frames[k].disc->cs, *sh, kDt, m), Status::kOk);
+    onsets += m.slip_onset ? 1 : 0;
+    const dsp_ref::SensorMotionRef r = free_ref.update(frames[k].disc->ref, sx, sy, kDt);
+    ASSERT_EQ(r.slipping, m.slipping) << "frame " << k;
+    ASSERT_EQ(r.anchor_set, m.anchor_set) << "frame " << k;
+    ASSERT_EQ(static_cast<int>(r.samples.size()), m.slipping ? m.points : m.moments.n)
+        << "frame " << k;
+    fixed.push_back(m);
+    decisions.push_back(
+        {m.slipping, m.stick_confirmed, m.slip_onset, m.releasing, true, m.anchor_set});
+  }
+  ASSERT_EQ(onsets, 1);
+  // The one anchor set on the large disc is at the slide's last frame.
+  std::size_t first_large = 0, slide_end = 0;
+  while (frames[first_large].disc != &large) ++first_large;
+  int sets_on_large = 0;
+  for (std::size_t k = first_large; k < frames.size(); ++k) {
+    if (!fixed[k].anchor_set) continue;
+    ++sets_on_large;
+    slide_end = k;
+  }
+  ASSERT_EQ(sets_on_large, 1);
+  ASSERT_LT(slide_end + 1, frames.size());
+  EXPECT_TRUE(fixed[slide_end].slipping);
+  EXPECT_FALSE(fixed[slide_end + 1].slipping);
+  EXPECT_GT(fixed[slide_end].shear_shift_m, 2.0 * cal.slip_min_shift_m);
+  // Before it, sticking on the large disc read the small one; after it, the large one.
+  for (std::size_t k = first_large + 1; k < frames.size(); ++k) {
+    if (fixed[k].slipping) continue;
+    EXPECT_EQ(fixed[k].moments.n, k > slide_end ? large.cs->count : small.cs->count)
+        << "frame " << k;
+  }
+
+  // Locked: the given anchors (the fixed path's), and then the same without the one at the
+  // slide's end, which leaves the small disc anchored.
+  std::vector<dsp_ref::SlipDecision> without = decisions;
+  without[slide_end].anchor_set = false;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    frames[k].disc->shear(0.0, frames[k].tx, cal.c_displacement, *sh, sx, sy);
+    const dsp_ref::SensorMotionRef l =
+        locked.update(frames[k].disc->ref, sx, sy, kDt, &decisions[k]);
+    const dsp_ref::SensorMotionRef o = other.update(frames[k].disc->ref, sx, sy, kDt, &without[k]);
+    EXPECT_EQ(l.anchor_set, decisions[k].anchor_set) << "frame " << k;
+    EXPECT_EQ(o.anchor_set, without[k].anchor_set) << "frame " << k;
+    if (k > slide_end) {
+      EXPECT_EQ(static_cast<int>(l.samples.size()), large.cs->count) << "frame " << k;
+      EXPECT_EQ(static_cast<int>(o.samples.size()), small.cs->count) << "frame " << k;
+    }
+  }
+}
+
 // The decision-locked reference (dsp_ref::SlipDecision, used only to report a second fixed−ref
 // figure): following the fixed pipeline's decisions reproduces them frame by frame, also when
 // the reference's own detector would decide differently (here: a delayed onset imposed on it).
