@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <numbers>
 
@@ -151,6 +152,76 @@ TEST(SimPhysics, StickRotationFollowsSurfaceKinematicsExactly) {
 TEST(SimPhysics, StickTranslationFollowsSurfaceKinematicsExactly) {
   expect_stick_kinematics(MotionAxis::kTx, 0.6);
   expect_stick_kinematics(MotionAxis::kTy, -0.4);
+}
+
+// Stick bonds the gel to the object: the material now at c sits where the object carried it
+// since the motion started, bulge and all (docs/simulator.md §6). For a torsion of a centred
+// sphere the bulge is radial and does not change, so the material now at c came from R⁻¹c and
+// was displaced there by U_n(R⁻¹c) = R⁻¹U_n(c): U(c) = c − R⁻¹c + R⁻¹U_n(c). The plain sum
+// U_t + U_n leaves the bulge vector unturned (off by θ|U_n|, 15 µm here), which made the image's
+// patch turn faster than the object (a raw-flow torsion of 4.57° for 4°). In a translation the
+// bulge moves with the object: U(c) = t + U_n(c), the plain sum (sampling the moved bulge where
+// the material came from would shift it twice, by t·∇U_n: 41 µm here).
+TEST(SimPhysics, AStuckObjectCarriesTheBulgedGelWithIt) {
+  struct Case {
+    MotionAxis axis;
+    double magnitude;
+  };
+  for (const Case& m : {Case{MotionAxis::kRz, 4.0}, Case{MotionAxis::kTx, 0.6}}) {
+    auto sim = make(sphere_config(m.axis, m.magnitude, Regime::kStick));
+    ASSERT_TRUE(sim);
+    const double t = sim->scenario().motion_start_s() + sim->scenario().motion_duration_s();
+    run_to(*sim, t);
+    const Pose pose = sim->scenario().pose(t);
+    for (Sensor p : kBoth) {
+      const PadFields& f = sim->fields(p);
+      const Eigen::Matrix3d rpad = pad_rotation(p);
+      // The in-plane rotation the pad sees (the right pad is mirrored: −θ), and the shift.
+      const Eigen::Matrix2d r_inv =
+          (rpad * pose.q.conjugate().toRotationMatrix() * rpad.transpose()).topLeftCorner<2, 2>();
+      const Eigen::Vector2d shift = (rpad * pose.p).head<2>();
+      int cells = 0;
+      double worst = 0.0, plain_sum_off = 0.0, twice_shifted_off = 0.0;
+      for (int j = 0; j < f.gh; ++j) {
+        for (int i = 0; i < f.gw; ++i) {
+          const std::size_t k = f.index(i, j);
+          if (!f.contact[k]) continue;
+          const Eigen::Vector2d c(f.u_mm[static_cast<std::size_t>(i)],
+                                  f.v_mm[static_cast<std::size_t>(j)]);
+          const Eigen::Vector2d un(f.normal_x[k], f.normal_y[k]);
+          const Eigen::Vector2d ut(f.tangential_x[k], f.tangential_y[k]);
+          const Eigen::Vector2d expected =
+              m.axis == MotionAxis::kRz ? Eigen::Vector2d(c - r_inv * c + r_inv * un)
+                                        : Eigen::Vector2d(shift + un);
+          const Eigen::Vector2d total(f.total_x[k], f.total_y[k]);
+          ++cells;
+          worst = std::max(worst, (total - expected).norm());
+          plain_sum_off = std::max(plain_sum_off, (ut + un - expected).norm());
+          // The current bulge sampled where the material came from, c − t (t along x here),
+          // linearly between the two cells around it.
+          const double back = shift.x() / f.cell_mm;
+          const int b0 = static_cast<int>(std::floor(back));
+          if (m.axis == MotionAxis::kTx && i - b0 - 1 >= 0 && i - b0 < f.gw) {
+            const double w = back - b0;
+            const std::size_t k0 = f.index(i - b0, j), k1 = f.index(i - b0 - 1, j);
+            const Eigen::Vector2d moved((1.0 - w) * f.normal_x[k0] + w * f.normal_x[k1],
+                                        (1.0 - w) * f.normal_y[k0] + w * f.normal_y[k1]);
+            twice_shifted_off = std::max(twice_shifted_off, (shift + moved - expected).norm());
+          }
+        }
+      }
+      EXPECT_GT(cells, 500);
+      std::printf("%s %s: %d cells, off by %.1f um (plain sum %.1f um, bulge shifted twice %.1f um)\n",
+                  to_string(m.axis), to_string(p), cells, worst * 1e3,
+                  plain_sum_off * 1e3, twice_shifted_off * 1e3);
+      EXPECT_LT(worst, 3e-3) << to_string(m.axis) << " " << to_string(p);  // mm: bilinear sampling
+      if (m.axis == MotionAxis::kRz) {
+        EXPECT_GT(plain_sum_off, 10e-3) << "the bulge must be large enough to tell them apart";
+      } else {
+        EXPECT_GT(twice_shifted_off, 10e-3) << "the bulge must be large enough to tell them apart";
+      }
+    }
+  }
 }
 
 TEST(SimPhysics, RightPadIsMirroredImageYIsMinusGy) {

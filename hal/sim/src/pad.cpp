@@ -67,6 +67,10 @@ void PadFields::allocate(const RigSpec& rig) {
   normal_y.assign(n, 0.0);
   tangential_x.assign(n, 0.0);
   tangential_y.assign(n, 0.0);
+  bonded_normal_x.assign(n, 0.0);
+  bonded_normal_y.assign(n, 0.0);
+  bond_x.assign(n, 0.0);
+  bond_y.assign(n, 0.0);
   total_x.assign(n, 0.0);
   total_y.assign(n, 0.0);
   slide_vx.assign(n, 0.0);
@@ -101,7 +105,8 @@ void PadPhysics::build(Sensor sensor, const RigSpec& rig, const GelSpec& gel,
 void PadPhysics::reset() noexcept {
   std::fill(f_.height_mm.begin(), f_.height_mm.end(), kNaN);
   for (auto* v : {&f_.depth_mm, &f_.smooth_depth_mm, &f_.normal_x, &f_.normal_y, &f_.tangential_x,
-                  &f_.tangential_y, &f_.total_x, &f_.total_y, &f_.slide_vx, &f_.slide_vy}) {
+                  &f_.tangential_y, &f_.bonded_normal_x, &f_.bonded_normal_y, &f_.bond_x,
+                  &f_.bond_y, &f_.total_x, &f_.total_y, &f_.slide_vx, &f_.slide_vy}) {
     std::fill(v->begin(), v->end(), 0.0);
   }
   std::fill(f_.contact.begin(), f_.contact.end(), std::uint8_t{0});
@@ -385,7 +390,6 @@ void PadPhysics::compute_tangential(const Scenario& scn, const Pose& pose, doubl
 }
 
 void PadPhysics::spread() noexcept {
-  const int gw = f_.gw, gh = f_.gh;
   bool any = false;
   for (auto c : f_.contact) any = any || c != 0;
   if (!any) {
@@ -394,13 +398,16 @@ void PadPhysics::spread() noexcept {
     labels_.spread_sweeps = 0;
     return;
   }
-  // Thin elastic layer on a rigid backing: outside the patch the in-plane displacement obeys
-  // lambda^2 lap(U) = U (screened Poisson), with U given on the patch and free (Neumann)
-  // image borders. Red-black SOR, warm-started from the previous frame.
+  labels_.spread_sweeps = spread_field(f_.tangential_x.data(), f_.tangential_y.data());
+}
+
+// Thin elastic layer on a rigid backing: outside the patch the in-plane displacement obeys
+// lambda^2 lap(U) = U (screened Poisson), with U given on the patch and free (Neumann) image
+// borders. Red-black SOR, warm-started from the previous frame's values off the patch.
+int PadPhysics::spread_field(double* ux, double* uy) noexcept {
+  const int gw = f_.gw, gh = f_.gh;
   const double alpha = static_cast<double>(std::pow(f_.cell_mm / gel_.spread_length_mm, 2.0));
   const auto omega = static_cast<double>(kSorOmega);
-  double* ux = f_.tangential_x.data();
-  double* uy = f_.tangential_y.data();
   const std::uint8_t* fixed = f_.contact.data();
   int sweep = 0;
   for (; sweep < kSorMaxSweeps; ++sweep) {
@@ -445,7 +452,7 @@ void PadPhysics::spread() noexcept {
       break;
     }
   }
-  labels_.spread_sweeps = sweep;
+  return sweep;
 }
 
 void PadPhysics::compute_labels(bool sliding) noexcept {
@@ -474,6 +481,58 @@ void PadPhysics::compute_labels(bool sliding) noexcept {
   labels_.slipping = labels_.slip_fraction > 0.5;
 }
 
+// Stick: the gel over the patch is bonded to the object, so the material now at c is where the
+// object carried it since the motion started, bulge and all: it sat at c − U_t(c) then, displaced
+// by that moment's bulge U_n0, so U(c) = U_t(c) + U_n0(c − U_t(c)) over the patch (docs/
+// simulator.md §6). The bond's correction to the current bulge, B = U_n0(c − U_t(c)) − U_n(c), is
+// set on the patch and spread outside it like U_t. A plain sum U_t + U_n made a stuck torsion's
+// bulged gel turn 1/(1 − k) times as fast as the object (U_n ≈ k r inside the patch): the bulge
+// vector stayed unturned while the material carrying it turned. Where the bulge moves with the
+// object (a translation) B is ≈ 0. A slide is not bonded (B = 0): the bulge follows the
+// indenter. U_n0 is sampled bilinearly between cells.
+void PadPhysics::bond_normal(bool sliding, bool moving) noexcept {
+  if (sliding || !moving) {
+    // Before the motion (or in a slide) nothing is bonded yet: keep the bulge as it is now.
+    f_.bonded_normal_x = f_.normal_x;
+    f_.bonded_normal_y = f_.normal_y;
+    std::fill(f_.bond_x.begin(), f_.bond_x.end(), 0.0);
+    std::fill(f_.bond_y.begin(), f_.bond_y.end(), 0.0);
+    return;
+  }
+  const int gw = f_.gw, gh = f_.gh;
+  const double inv_cell = 1.0 / f_.cell_mm;
+  bool any = false;
+  for (int j = 0; j < gh; ++j) {
+    for (int i = 0; i < gw; ++i) {
+      const std::size_t k = f_.index(i, j);
+      if (!f_.contact[k]) continue;
+      any = true;
+      const double fi =
+          std::clamp(i - f_.tangential_x[k] * inv_cell, 0.0, static_cast<double>(gw - 1));
+      const double fj =
+          std::clamp(j - f_.tangential_y[k] * inv_cell, 0.0, static_cast<double>(gh - 1));
+      const int i0 = std::min(static_cast<int>(fi), gw - 2);
+      const int j0 = std::min(static_cast<int>(fj), gh - 2);
+      const double wx = fi - i0, wy = fj - j0;
+      const auto bilinear = [&](const std::vector<double>& v) {
+        const double top =
+            v[f_.index(i0, j0)] + wx * (v[f_.index(i0 + 1, j0)] - v[f_.index(i0, j0)]);
+        const double bottom =
+            v[f_.index(i0, j0 + 1)] + wx * (v[f_.index(i0 + 1, j0 + 1)] - v[f_.index(i0, j0 + 1)]);
+        return top + wy * (bottom - top);
+      };
+      f_.bond_x[k] = bilinear(f_.bonded_normal_x) - f_.normal_x[k];
+      f_.bond_y[k] = bilinear(f_.bonded_normal_y) - f_.normal_y[k];
+    }
+  }
+  if (!any) {
+    std::fill(f_.bond_x.begin(), f_.bond_x.end(), 0.0);
+    std::fill(f_.bond_y.begin(), f_.bond_y.end(), 0.0);
+    return;
+  }
+  (void)spread_field(f_.bond_x.data(), f_.bond_y.data());
+}
+
 SimStatus PadPhysics::step(const Scenario& scn, const Shape& shape, double t) noexcept {
   if (has_last_ && t < t_last_ - 1e-12) return SimStatus::kTimeBackwards;
   const double local = scn.local_time(t);
@@ -484,9 +543,10 @@ SimStatus PadPhysics::step(const Scenario& scn, const Shape& shape, double t) no
   compute_normal();
   compute_tangential(scn, pose, local, dt, shape.spec().friction * gel_.shear_compliance);
   spread();
+  bond_normal(scn.sliding(), local >= scn.motion_start_s());
   for (std::size_t k = 0; k < f_.total_x.size(); ++k) {
-    f_.total_x[k] = f_.tangential_x[k] + f_.normal_x[k];
-    f_.total_y[k] = f_.tangential_y[k] + f_.normal_y[k];
+    f_.total_x[k] = f_.tangential_x[k] + f_.bond_x[k] + f_.normal_x[k];
+    f_.total_y[k] = f_.tangential_y[k] + f_.bond_y[k] + f_.normal_y[k];
   }
   compute_labels(scn.sliding());
   t_last_ = t;

@@ -54,7 +54,11 @@ struct PadFields {
   std::vector<double> smooth_depth_mm;             // Phi = G_sigma * d (gel surface deflection)
   std::vector<double> normal_x, normal_y;          // bulge -k grad(Phi)
   std::vector<double> tangential_x, tangential_y;  // shear field (stick or slide, spread)
-  std::vector<double> total_x, total_y;            // normal + tangential
+  // Stick: the bulge as it was when the motion started (the gel then bonded to the object), and
+  // the correction the bond makes to the current bulge, on the patch and spread outside it.
+  std::vector<double> bonded_normal_x, bonded_normal_y;
+  std::vector<double> bond_x, bond_y;
+  std::vector<double> total_x, total_y;    // tangential + bond + normal
   std::vector<double> slide_vx, slide_vy;  // object surface velocity over the pad at contact cells
   std::vector<double> shade;               // multiplicative shading
   double pad_surface_mm = 0.0;  // undeformed gel surface position along n (half the separation)
@@ -101,6 +105,8 @@ class PadPhysics {
   void compute_tangential(const Scenario& scn, const Pose& pose, double t, double dt,
                           double umax_per_mm) noexcept;
   void spread() noexcept;
+  int spread_field(double* ux, double* uy) noexcept;  // SOR sweeps used
+  void bond_normal(bool sliding, bool moving) noexcept;
   void compute_labels(bool sliding) noexcept;
 
   static constexpr int kMaxSubsteps = 64;
