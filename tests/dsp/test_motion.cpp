@@ -374,6 +374,16 @@ TEST(Motion, DisplacementIncrementsOnlyFromCellsInBothMasks) {
   EXPECT_NEAR(m.omega.z(), 0.5, 1e-4);
 }
 
+// kDisplacement without the solve's regularisation (λ and the lever floor at 0), so a rigid
+// increment is read exactly.
+Calibration exact_displacement_cal() {
+  Calibration cal;
+  cal.velocity_proxy = VelocityProxy::kDisplacement;
+  cal.solve_lambda_rel = 0.0;
+  cal.solve_lever_floor_m = 0.0;
+  return cal;
+}
+
 // A held tangential load stretches the gel behind the patch, and 𝒢 reads the stretch as normal
 // load: Ω grows over gel that follows the object only partly (the simulator's sphere rx 4°
 // stick: 106 cells before the motion, 315 after). The displacement proxy reads its increments
@@ -382,10 +392,7 @@ TEST(Motion, DisplacementIncrementsOnlyFromCellsInBothMasks) {
 // gaining half the rigid increment. The anchored reading is the rigid torsion; over the whole
 // Ω_t ∩ Ω_{t−1} the ring would dilute it. Fixed path and double reference alike.
 TEST(Motion, AHeldTangentialLoadIsReadOverThePatchNotTheStretchedGel) {
-  Calibration cal;
-  cal.velocity_proxy = VelocityProxy::kDisplacement;
-  cal.solve_lambda_rel = 0.0;
-  cal.solve_lever_floor_m = 0.0;
+  const Calibration cal = exact_displacement_cal();
   RigidContactScene small, large;
   small.radius_m = 3e-3;
   large.radius_m = 4.5e-3;
@@ -504,10 +511,7 @@ TEST(Motion, AHeldTangentialLoadIsReadOverThePatchNotTheStretchedGel) {
 // patch moves off it in one frame, a tangential load held) is read over Ω_t ∩ Ω_{t−1} rather
 // than from nothing. Fixed path and double reference alike.
 TEST(Motion, AContactThatLeftItsAnchoredCellsIsReadOverTheCellsItKept) {
-  Calibration cal;
-  cal.velocity_proxy = VelocityProxy::kDisplacement;
-  cal.solve_lambda_rel = 0.0;
-  cal.solve_lever_floor_m = 0.0;
+  const Calibration cal = exact_displacement_cal();
   RigidContactScene first, moved;
   first.radius_m = moved.radius_m = 2.5e-3;
   first.contact_centre_G = Eigen::Vector3d(-4e-3, 0.0, 0.0);

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -83,6 +84,51 @@ tt::PoseErrors replay_errors(const tt::SimCase& c, const tacse3::config::Calibra
     poses.push_back(row.pose);
   }
   return tt::pose_errors(poses, info.truth, info.t_ns);
+}
+
+// Replays a case twice in lock step with the defaults: as rendered, and altered frame by frame
+// by `alter` (which may withhold a pad's view or move the frame's time; it returns whether it
+// changed frame i). Final-pose errors of both, how far apart they end, and how many altered
+// frames were fused from a single pad.
+struct WholeAndAltered {
+  tt::PoseErrors whole, altered;
+  double apart_deg = 0.0;
+  int single_altered = 0;
+};
+using Alteration =
+    std::function<bool(std::size_t, std::array<const tacse3::dsp::FrameView*, 2>&, std::int64_t&)>;
+WholeAndAltered replay_whole_and_altered(const tt::SimCase& c,
+                                         const tacse3::config::CalibrationSet& cal,
+                                         const Alteration& alter) {
+  WholeAndAltered r;
+  std::string err;
+  const auto src = open_sim(c, &err);
+  EXPECT_TRUE(src) << err;
+  if (!src) return r;
+  const tt::SourceInfo& info = src->info();
+  tt::ReplayOptions o;
+  o.calibration = cal;
+  tt::Replayer whole, altered;
+  EXPECT_EQ(whole.init(info, o), "");
+  EXPECT_EQ(altered.init(info, o), "");
+  std::vector<tacse3::dsp::Pose> poses[2];
+  tt::FrameResult row;
+  for (std::size_t i = 0; i < info.frame_count(); ++i) {
+    std::array<const tacse3::dsp::FrameView*, 2> views{};
+    EXPECT_EQ(src->read(i, &views), "");
+    EXPECT_EQ(whole.step_views(views, info.t_ns[i], i, &row), "");
+    poses[0].push_back(row.pose);
+    std::int64_t t_ns = info.t_ns[i];
+    const bool changed = alter(i, views, t_ns);
+    EXPECT_EQ(altered.step_views(views, t_ns, i, &row), "");
+    poses[1].push_back(row.pose);
+    r.single_altered += changed && row.single_sensor ? 1 : 0;
+  }
+  // Against the truth at the rendered times: the poses are those of the same frames.
+  r.whole = tt::pose_errors(poses[0], info.truth, info.t_ns);
+  r.altered = tt::pose_errors(poses[1], info.truth, info.t_ns);
+  r.apart_deg = tt::rotation_error_deg(poses[0].back().q, poses[1].back().q);
+  return r;
 }
 
 // Loose bounds: they catch a broken stage, a sign or frame error, a calibration that stops
@@ -175,42 +221,27 @@ TEST(Accuracy, CalibratedPipelineTracksShortSimulatedGrasps) {
 TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
-  // A stick torsion of a small sphere (small contacts, short levers).
-  const tt::SimCase c = sim_case("sphere", "rz", 4.0, 1, 15.0);
-  std::string err;
-  const auto src = open_sim(c, &err);
-  ASSERT_TRUE(src) << err;
-  const tt::SourceInfo& info = src->info();
-  tt::ReplayOptions o;
-  o.calibration = cal;
-  tt::Replayer whole, gappy;
-  ASSERT_EQ(whole.init(info, o), "");
-  ASSERT_EQ(gappy.init(info, o), "");
-  // The hold starts 1.17 s in (frame 140 of 188): the right pad misses 140-149 and 165-174.
-  auto missing = [](std::size_t i) { return (i >= 140 && i < 150) || (i >= 165 && i < 175); };
-  std::vector<tacse3::dsp::Pose> poses[2];
-  int single = 0;  // single-pad frames inside the withheld windows
-  tt::FrameResult row;
-  for (std::size_t i = 0; i < info.frame_count(); ++i) {
-    std::array<const tacse3::dsp::FrameView*, 2> views{};
-    ASSERT_EQ(src->read(i, &views), "");
-    ASSERT_EQ(whole.step_views(views, info.t_ns[i], i, &row), "");
-    poses[0].push_back(row.pose);
-    if (missing(i)) views[1] = nullptr;
-    ASSERT_EQ(gappy.step_views(views, info.t_ns[i], i, &row), "");
-    poses[1].push_back(row.pose);
-    single += missing(i) && row.single_sensor ? 1 : 0;
-  }
-  const tt::PoseErrors e0 = tt::pose_errors(poses[0], info.truth, info.t_ns);
-  const tt::PoseErrors e1 = tt::pose_errors(poses[1], info.truth, info.t_ns);
-  const double apart = tt::rotation_error_deg(poses[0].back().q, poses[1].back().q);
-  std::printf("sphere rz 4, radius 15 mm: error %.2f deg with both pads, %.2f deg with the right pad missing "
-              "for 20 frames of the hold (%d of them single-pad); the two end %.3f deg apart\n",
-              e0.final_rotation_error_deg, e1.final_rotation_error_deg, single, apart);
-  EXPECT_EQ(single, 20);
-  EXPECT_LT(e0.final_rotation_error_deg, 1.0);  // its right mask also flickers out by itself
-  EXPECT_LT(e1.final_rotation_error_deg, 1.0);
-  EXPECT_LT(apart, 0.3);
+  // A stick torsion of a small sphere (small contacts, short levers). The hold starts 1.17 s in
+  // (frame 140 of 188): the right pad misses 140-149 and 165-174.
+  const WholeAndAltered r = replay_whole_and_altered(
+      sim_case("sphere", "rz", 4.0, 1, 15.0), cal,
+      [](std::size_t i, std::array<const tacse3::dsp::FrameView*, 2>& views, std::int64_t&) {
+        if ((i >= 140 && i < 150) || (i >= 165 && i < 175)) {
+          views[1] = nullptr;
+          return true;
+        }
+        return false;
+      });
+  std::printf(
+      "sphere rz 4, radius 15 mm: error %.2f deg with both pads, %.2f deg with the right pad "
+      "missing "
+      "for 20 frames of the hold (%d of them single-pad); the two end %.3f deg apart\n",
+      r.whole.final_rotation_error_deg, r.altered.final_rotation_error_deg, r.single_altered,
+      r.apart_deg);
+  EXPECT_EQ(r.single_altered, 20);
+  EXPECT_LT(r.whole.final_rotation_error_deg, 1.0);  // its right mask also flickers out by itself
+  EXPECT_LT(r.altered.final_rotation_error_deg, 1.0);
+  EXPECT_LT(r.apart_deg, 0.3);
 }
 
 // Stick grasps on the objects where the detector used to call a slip: a small sphere, a sphere
@@ -456,37 +487,21 @@ TEST(Accuracy, AFrameGapDuringAStickMotionKeepsThePatchAnchor) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
   const tt::SimCase c = sim_case("sphere", "rx", 4.0, 1, 0.0);
-  std::string err;
-  const auto src = open_sim(c, &err);
-  ASSERT_TRUE(src) << err;
-  const tt::SourceInfo& info = src->info();
-  tt::ReplayOptions o;
-  o.calibration = cal;
-  tt::Replayer whole, gappy;
-  ASSERT_EQ(whole.init(info, o), "");
-  ASSERT_EQ(gappy.init(info, o), "");
   // The motion runs 0.6-1.2 s; from 0.9 s (frame 108, half-way) the clock jumps by 0.2 s.
-  constexpr std::size_t kGapFrame = 108;
-  constexpr std::int64_t kGapNs = 200'000'000;
-  std::vector<tacse3::dsp::Pose> poses[2];
-  tt::FrameResult row;
-  for (std::size_t i = 0; i < info.frame_count(); ++i) {
-    std::array<const tacse3::dsp::FrameView*, 2> views{};
-    ASSERT_EQ(src->read(i, &views), "");
-    ASSERT_EQ(whole.step_views(views, info.t_ns[i], i, &row), "");
-    poses[0].push_back(row.pose);
-    ASSERT_EQ(gappy.step_views(views, info.t_ns[i] + (i >= kGapFrame ? kGapNs : 0), i, &row), "");
-    poses[1].push_back(row.pose);
-  }
-  const tt::PoseErrors e0 = tt::pose_errors(poses[0], info.truth, info.t_ns);
-  const tt::PoseErrors e1 = tt::pose_errors(poses[1], info.truth, info.t_ns);
+  const WholeAndAltered r = replay_whole_and_altered(
+      c, cal, [](std::size_t i, std::array<const tacse3::dsp::FrameView*, 2>&, std::int64_t& t) {
+        if (i < 108) return false;
+        t += 200'000'000;
+        return true;
+      });
   std::printf("%s: %.2f deg (error %.2f), with a 0.2 s gap half-way %.2f deg (error %.2f)\n",
-              c.sim_arguments().c_str(), e0.estimated_rotation_deg, e0.final_rotation_error_deg,
-              e1.estimated_rotation_deg, e1.final_rotation_error_deg);
-  EXPECT_LT(e0.final_rotation_error_deg, 0.2);
+              c.sim_arguments().c_str(), r.whole.estimated_rotation_deg,
+              r.whole.final_rotation_error_deg, r.altered.estimated_rotation_deg,
+              r.altered.final_rotation_error_deg);
+  EXPECT_LT(r.whole.final_rotation_error_deg, 0.2);
   // The gap loses the one increment across it (the fastest frame of the motion: 0.1°).
-  EXPECT_LT(e1.final_rotation_error_deg, 0.25);
-  EXPECT_LT(e0.estimated_rotation_deg - e1.estimated_rotation_deg, 0.2);
+  EXPECT_LT(r.altered.final_rotation_error_deg, 0.25);
+  EXPECT_LT(r.whole.estimated_rotation_deg - r.altered.estimated_rotation_deg, 0.2);
 }
 
 // Every axis a recording turns about is fitted for the proxy that explains it, from 1 deg of
