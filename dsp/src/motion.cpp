@@ -202,6 +202,9 @@ void MotionEstimator::reset() noexcept {
 }
 
 void MotionEstimator::restart() noexcept {
+  // A slide in progress may end during the gap, where its end (which re-anchors) is never seen:
+  // the patch anchored before the slide is stale, so the next frame anchors its own Ω.
+  if (slipping_) have_anchor_ = false;
   prev_mask_.fill(0);
   prev_x_nm_.fill(0);
   prev_y_nm_.fill(0);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <numbers>
 #include <vector>
@@ -646,6 +647,36 @@ TEST(SlipDetector, ASlideEndsWithThePatchItLeftAnchored) {
       EXPECT_EQ(static_cast<int>(o.samples.size()), small.cs->count) << "frame " << k;
     }
   }
+
+  // A gap in the stream that swallows the slide's end (MotionEstimator::restart(), as the
+  // pipeline calls it, at the frame the slide ended): the restarted detector never sees the end,
+  // so restart() drops the pre-slide anchor while sliding and the frame after the gap anchors its
+  // own Ω. The held stick after it reads the large disc, not the small one.
+  const std::size_t gap = slide_end;
+  auto gapped = std::make_unique<MotionEstimator>();
+  ASSERT_EQ(gapped->configure(cal), Status::kOk);
+  int read_large = 0, read_small = 0, sets_after_gap = 0;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    if (k == gap) gapped->restart();
+    frames[k].disc->shear(0.0, frames[k].tx, cal.c_displacement, *sh, sx, sy);
+    SensorMotion m;
+    ASSERT_EQ(gapped->update(*frames[k].disc->cs, *sh, kDt, m), Status::kOk);
+    if (k == gap) {
+      EXPECT_TRUE(m.anchor_set);
+    } else if (k > gap) {
+      sets_after_gap += m.anchor_set ? 1 : 0;
+    }
+    if (k > slide_end && !m.slipping) {
+      read_large += m.moments.n == large.cs->count ? 1 : 0;
+      read_small += m.moments.n == small.cs->count ? 1 : 0;
+    }
+  }
+  std::printf(
+      "after a gap at the slide's end: %d anchors set later, %d stick frames read the large disc, "
+      "%d the small one\n",
+      sets_after_gap, read_large, read_small);
+  EXPECT_GT(read_large, 20);
+  EXPECT_EQ(read_small, 0);
 }
 
 // The decision-locked reference (dsp_ref::SlipDecision, used only to report a second fixed−ref

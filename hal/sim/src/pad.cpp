@@ -113,6 +113,7 @@ void PadPhysics::reset() noexcept {
   std::fill(f_.shade.begin(), f_.shade.end(), 1.0);
   labels_ = PadLabels{};
   has_last_ = false;
+  bond_captured_ = false;
   has_height_ = false;
   t_last_ = 0.0;
   local_last_ = 0.0;
@@ -489,16 +490,22 @@ void PadPhysics::compute_labels(bool sliding) noexcept {
 // bulged gel turn 1/(1 − k) times as fast as the object (U_n ≈ k r inside the patch): the bulge
 // vector stayed unturned while the material carrying it turned. Where the bulge moves with the
 // object (a translation) B is ≈ 0. A slide is not bonded (B = 0): the bulge follows the
-// indenter. U_n0 is sampled bilinearly between cells.
-void PadPhysics::bond_normal(bool sliding, bool moving) noexcept {
-  if (sliding || !moving) {
-    // Before the motion (or in a slide) nothing is bonded yet: keep the bulge as it is now.
+// indenter. U_n0 is sampled bilinearly between cells. load_ratio (the commanded indentation over
+// the grasp's, in [0, 1]) scales U_n0: as the pads open the bonded gel's bulge relaxes with the
+// load, so B falls to 0 with the contact instead of vanishing with its last cell.
+void PadPhysics::bond_normal(bool sliding, bool moving, double load_ratio) noexcept {
+  if (sliding || !moving || !bond_captured_) {
+    // Nothing bonded yet: keep the bulge as it is now. Before the motion B = 0 (and a slide is
+    // never bonded); a pad first stepped during the motion (the live camera joins a scenario at
+    // the present) bonds the bulge it finds.
     f_.bonded_normal_x = f_.normal_x;
     f_.bonded_normal_y = f_.normal_y;
+    bond_captured_ = !sliding;
     std::fill(f_.bond_x.begin(), f_.bond_x.end(), 0.0);
     std::fill(f_.bond_y.begin(), f_.bond_y.end(), 0.0);
-    return;
+    if (sliding || !moving) return;
   }
+  const double scale = std::clamp(load_ratio, 0.0, 1.0);
   const int gw = f_.gw, gh = f_.gh;
   const double inv_cell = 1.0 / f_.cell_mm;
   bool any = false;
@@ -521,8 +528,8 @@ void PadPhysics::bond_normal(bool sliding, bool moving) noexcept {
             v[f_.index(i0, j0 + 1)] + wx * (v[f_.index(i0 + 1, j0 + 1)] - v[f_.index(i0, j0 + 1)]);
         return top + wy * (bottom - top);
       };
-      f_.bond_x[k] = bilinear(f_.bonded_normal_x) - f_.normal_x[k];
-      f_.bond_y[k] = bilinear(f_.bonded_normal_y) - f_.normal_y[k];
+      f_.bond_x[k] = scale * bilinear(f_.bonded_normal_x) - f_.normal_x[k];
+      f_.bond_y[k] = scale * bilinear(f_.bonded_normal_y) - f_.normal_y[k];
     }
   }
   if (!any) {
@@ -543,7 +550,8 @@ SimStatus PadPhysics::step(const Scenario& scn, const Shape& shape, double t) no
   compute_normal();
   compute_tangential(scn, pose, local, dt, shape.spec().friction * gel_.shear_compliance);
   spread();
-  bond_normal(scn.sliding(), local >= scn.motion_start_s());
+  bond_normal(scn.sliding(), local >= scn.motion_start_s(),
+              scn.indentation_mm(local) / scn.spec().indentation_mm);
   for (std::size_t k = 0; k < f_.total_x.size(); ++k) {
     f_.total_x[k] = f_.tangential_x[k] + f_.bond_x[k] + f_.normal_x[k];
     f_.total_y[k] = f_.tangential_y[k] + f_.bond_y[k] + f_.normal_y[k];

@@ -183,7 +183,8 @@ class MotionEstimator {
   // Forget the previous frame but keep the patch anchor (call after a gap in the stream or a
   // missed frame): a tangential load held across the gap has left the gel stretched, and the
   // Ω of the next frame would anchor the stretched extent (docs/dsp.md §4.2c). The next frame
-  // without contact, or tangentially unloaded, replaces the anchor as usual.
+  // without contact, or tangentially unloaded, replaces the anchor as usual. While sliding, the
+  // anchor is dropped (the slide's end, which re-anchors, may fall in the gap).
   void restart() noexcept;
 
   // contact: this frame's ContactSet; shear: calibrated shear field (Q16 shear units);

@@ -106,7 +106,7 @@ class PadPhysics {
                           double umax_per_mm) noexcept;
   void spread() noexcept;
   int spread_field(double* ux, double* uy) noexcept;  // SOR sweeps used
-  void bond_normal(bool sliding, bool moving) noexcept;
+  void bond_normal(bool sliding, bool moving, double load_ratio) noexcept;
   void compute_labels(bool sliding) noexcept;
 
   static constexpr int kMaxSubsteps = 64;
@@ -122,6 +122,7 @@ class PadPhysics {
   int gauss_radius_ = 0;
   std::vector<double> scratch_;  // separable blur pass
   bool has_last_ = false;
+  bool bond_captured_ = false;  // bonded_normal holds the bulge of a frame before the motion
   bool has_height_ = false;
   double t_last_ = 0.0;
   double local_last_ = 0.0;
