@@ -122,7 +122,7 @@ class PadPhysics {
   int gauss_radius_ = 0;
   std::vector<double> scratch_;  // separable blur pass
   bool has_last_ = false;
-  bool bond_captured_ = false;  // bonded_normal holds the bulge of a frame before the motion
+  bool bond_captured_ = false;  // bonded_normal holds the bulge the bond started from
   bool has_height_ = false;
   double t_last_ = 0.0;
   double local_last_ = 0.0;
