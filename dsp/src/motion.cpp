@@ -198,6 +198,7 @@ void MotionEstimator::reset_detector() noexcept {
 void MotionEstimator::reset() noexcept {
   anchor_mask_.fill(0);
   have_anchor_ = false;
+  anchor_count_ = 0;
   restart();
 }
 
@@ -238,8 +239,9 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // with a shear increment: a cell that (re-)enters Ω was usually not tracked by the flow while
   // it was out, holds a stale shear, and its first increment would be the whole catch-up at the
   // patch rim (docs/accuracy.md: an uncalibrated sphere rz 4° stick read as 6.84°).
-  ContactMoments m, m_stayed, m_anchored;
-  ProxySums sum_shear, sum_increment, sum_anchored;
+  // m_held: the cells of Ω in the anchor (the velocity proxy's region while the shear is a drag).
+  ContactMoments m, m_stayed, m_anchored, m_held;
+  ProxySums sum_shear, sum_increment, sum_anchored, sum_held;
   const auto add_point = [](ContactMoments& c, std::int64_t x, std::int64_t y, std::int64_t z) {
     ++c.n;
     c.sx += x;
@@ -263,6 +265,11 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     const bool stayed = prev_mask_.v[i] != 0;
     add_point(m, x, y, z);
     sum_shear.add(x, y, z, sx, sy);
+    const bool anchored = have_anchor_ && anchor_mask_.v[i] != 0;
+    if (anchored) {
+      add_point(m_held, x, y, z);
+      sum_held.add(x, y, z, sx, sy);
+    }
     if (stayed) {
       std::int64_t dx = 0, dy = 0;
       if (have_prev_shear_) {
@@ -271,7 +278,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       }
       add_point(m_stayed, x, y, z);
       sum_increment.add(x, y, z, dx, dy);
-      if (have_anchor_ && anchor_mask_.v[i] != 0) {
+      if (anchored) {
         add_point(m_anchored, x, y, z);
         sum_anchored.add(x, y, z, dx, dy);
       }
@@ -290,6 +297,18 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   sum_increment.store(mi);
   ContactMoments ma = m_anchored;
   sum_anchored.store(ma);
+  ContactMoments mh = m_held;
+  sum_held.store(mh);
+  // The velocity proxy's region (kVelocityAnchorDragRatio above): Ω ∩ anchor while the shear over
+  // Ω is a drag and Ω and the anchor still share enough cells, else Ω. The ratio test is on the
+  // unscaled shear (both parts in the same units); the overlap test in exact integers.
+  const Eigen::Vector3d shear_content = planar_content(mv, 1.0);
+  const bool drag = shear_content.tail<2>().norm() >=
+                    kVelocityAnchorDragRatio * std::abs(shear_content.x());
+  out.velocity_anchored =
+      drag && mh.n > 0 &&
+      static_cast<double>(mh.n) >= kVelocityAnchorMinOverlap * static_cast<double>(std::min(anchor_count_, m.n));
+  const ContactMoments& mvel = out.velocity_anchored ? mh : mv;
 
   // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
   // and its relative rate of fall ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) · Δt), EMA the
@@ -389,7 +408,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // before the motion, 315 after), which diluted the mean increment more the larger the motion
   // (docs/dsp.md §4.2c). Over Ω_t ∩ Ω_{t−1} alone if the anchor and Ω no longer share a cell.
   out.velocity_differs = automatic && sticking;
-  out.moments = sticking ? (ma.n > 0 ? ma : mi) : mv;
+  out.moments = sticking ? (ma.n > 0 ? ma : mi) : mvel;
   // A sticking contact whose load falls faster than release_load_rate is being let go: the
   // displacement proxy's increments are the gel springing back, not the object, so this frame's
   // chosen reading is dropped (rotation and translation; the velocity reading beside it stays).
@@ -505,11 +524,12 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     out.rotation_valid = out.proxy_valid && out.solve.valid;
   }
   if (out.velocity_differs) {
-    out.velocity_moments = mv;
+    out.velocity_moments = mvel;
     out.velocity_proxy_scale = velocity_scale;
     out.velocity_rotation_scale = rotation_scale_;
     if (m.n > 0) {
-      out.velocity_omega = solve_rotation(mv, velocity_scale, rotation_scale_, out.velocity_solve);
+      out.velocity_omega =
+          solve_rotation(mvel, velocity_scale, rotation_scale_, out.velocity_solve);
     }
   } else {
     out.velocity_moments = out.moments;
@@ -531,6 +551,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   } else if (!have_anchor_ || slide_ended ||
              planar_content(mv, c_displacement_ * kQ16Lsb).norm() <= min_shift_m_) {
     anchor_mask_ = contact.mask;
+    anchor_count_ = m.n;
     have_anchor_ = true;
     out.anchor_set = true;
   }

@@ -603,11 +603,16 @@ TEST(SlipDetector, ASlideEndsWithThePatchItLeftAnchored) {
     const dsp_ref::SensorMotionRef r = free_ref.update(frames[k].disc->ref, sx, sy, kDt);
     ASSERT_EQ(r.slipping, m.slipping) << "frame " << k;
     ASSERT_EQ(r.anchor_set, m.anchor_set) << "frame " << k;
-    ASSERT_EQ(static_cast<int>(r.samples.size()), m.slipping ? m.points : m.moments.n)
-        << "frame " << k;
+    // While slipping the velocity proxy reads the drag over Ω ∩ anchor (the small disc), as
+    // long as Ω holds it (docs/dsp.md §4.2d).
+    ASSERT_EQ(r.velocity_anchored, m.velocity_anchored) << "frame " << k;
+    ASSERT_EQ(static_cast<int>(r.samples.size()), m.moments.n) << "frame " << k;
+    if (m.slipping) {
+      ASSERT_EQ(m.moments.n, m.velocity_anchored ? small.cs->count : m.points) << "frame " << k;
+    }
     fixed.push_back(m);
-    decisions.push_back(
-        {m.slipping, m.stick_confirmed, m.slip_onset, m.releasing, true, m.anchor_set});
+    decisions.push_back({m.slipping, m.stick_confirmed, m.slip_onset, m.releasing, true,
+                         m.anchor_set, m.velocity_anchored});
   }
   ASSERT_EQ(onsets, 1);
   // The one anchor set on the large disc is at the slide's last frame.

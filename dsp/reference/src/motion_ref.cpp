@@ -8,6 +8,7 @@
 
 #include "tacse3/dsp/fixed.hpp"
 #include "tacse3/dsp/geometry.hpp"
+#include "tacse3/dsp/motion.hpp"  // the velocity proxy region constants
 
 namespace tacse3::dsp_ref {
 namespace {
@@ -88,6 +89,7 @@ void MotionRef::reset() {
   prev_mask_.assign(n, 0);
   anchor_.assign(n, 0);
   have_anchor_ = false;
+  anchor_count_ = 0;
   prev_q_.assign(n, Eigen::Vector3d::Zero());
   prev_sx_.assign(n, 0.0);
   prev_sy_.assign(n, 0.0);
@@ -117,6 +119,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       if (!release_follow->has_anchor &&
           std::find(prev_mask_.begin(), prev_mask_.end(), 1) != prev_mask_.end()) {
         anchor_ = prev_mask_;
+        anchor_count_ = static_cast<int>(std::count(anchor_.begin(), anchor_.end(), 1));
         have_anchor_ = true;
       }
     }
@@ -127,8 +130,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   Eigen::Vector3d zsum_now = Eigen::Vector3d::Zero(), zsum_prev = Eigen::Vector3d::Zero();
   double z_now = 0.0, z_prev = 0.0;
   Eigen::Vector3d sum_common = Eigen::Vector3d::Zero();
-  // Per point: shear (velocity reading), increment (displacement reading).
-  std::vector<PointSample> shear_pts, incr_pts, anchored_pts;
+  // Per point: shear (velocity reading, over Ω and over Ω ∩ anchor), increment (displacement
+  // reading).
+  std::vector<PointSample> shear_pts, held_pts, incr_pts, anchored_pts;
   for (std::size_t i = 0; i < n; ++i) {
     if (prev_mask_[i] != 0) {
       ++prev_count;
@@ -147,10 +151,12 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       dv = Eigen::Vector3d(shear_x[i] - prev_sx_[i], shear_y[i] - prev_sy_[i], 0.0);
     s.v = sv;
     shear_pts.push_back(s);
+    const bool anchored = have_anchor_ && anchor_[i] != 0;
+    if (anchored) held_pts.push_back(s);
     if (stayed) {
       s.v = dv;
       incr_pts.push_back(s);
-      if (have_anchor_ && anchor_[i] != 0) anchored_pts.push_back(s);
+      if (anchored) anchored_pts.push_back(s);
     }
     sum_now += s.q;
     zsum_now += s.q.z() * s.q;
@@ -204,7 +210,21 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   const bool sticking =
       automatic ? !slipping_ : cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
   bool slide_ended = false;
-  const double anchor_shift = planar(shear_pts).norm();  // |X| unsmoothed, for the anchor rule
+  const Eigen::Vector3d shear_content = planar(shear_pts);
+  const double anchor_shift = shear_content.norm();  // |X| unsmoothed, for the anchor rule
+  // The velocity proxy's region (dsp::kVelocityAnchorDragRatio's rule): Ω ∩ anchor while the
+  // shear is a drag and Ω and the anchor share enough cells; the followed decision if given.
+  out.velocity_anchored =
+      release_follow != nullptr && release_follow->has_anchor
+          ? release_follow->velocity_anchored
+          : shear_content.tail<2>().norm() >=
+                    dsp::kVelocityAnchorDragRatio * std::abs(shear_content.x()) &&
+                !held_pts.empty() &&
+                static_cast<double>(held_pts.size()) >=
+                    dsp::kVelocityAnchorMinOverlap *
+                    static_cast<double>(std::min(anchor_count_, out.points));
+  // A followed choice the reference's own anchor cannot serve (its anchor differs) reads Ω.
+  if (held_pts.empty()) out.velocity_anchored = false;
   if (automatic) {
     if (out.points == 0) {
       reset_detector();
@@ -263,12 +283,14 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   out.proxy_valid = (!sticking || have_prev_shear_) && !out.releasing;
   out.velocity_differs = automatic && sticking;
   for (auto& p : shear_pts) p.v *= cal_.c_velocity;
+  for (auto& p : held_pts) p.v *= cal_.c_velocity;
+  const std::vector<PointSample>& velocity_pts = out.velocity_anchored ? held_pts : shear_pts;
   if (sticking) {
     // Increments over the anchored patch (dsp::MotionEstimator's rule), Ω_t ∩ Ω_{t−1} if none.
     out.samples = anchored_pts.empty() ? incr_pts : anchored_pts;
     for (auto& p : out.samples) p.v *= have_prev_shear_ ? cal_.c_displacement / dt : 0.0;
   } else {
-    out.samples = shear_pts;
+    out.samples = velocity_pts;
   }
 
   const Eigen::Vector3d tscale(cal_.translation_scale[0], cal_.translation_scale[1],
@@ -334,9 +356,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     out.omega = out.rotation_scale.cwiseProduct(solve(out.samples));
   }
   if (out.velocity_differs) {
-    out.velocity_samples = shear_pts;
+    out.velocity_samples = velocity_pts;
     out.velocity_rotation_scale = wscale;
-    if (out.points > 0) out.velocity_omega = wscale.cwiseProduct(solve(shear_pts));
+    if (out.points > 0) out.velocity_omega = wscale.cwiseProduct(solve(velocity_pts));
   } else {
     out.velocity_samples = out.samples;
     out.velocity_rotation_scale = out.rotation_scale;
@@ -351,6 +373,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
                  ? release_follow->anchor_set
                  : (!have_anchor_ || slide_ended || anchor_shift <= cal_.slip_min_shift_m)) {
     anchor_ = c.mask;
+    anchor_count_ = out.points;
     have_anchor_ = true;
     out.anchor_set = true;
   }

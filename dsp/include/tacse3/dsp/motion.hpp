@@ -70,12 +70,30 @@ enum class TranslationSource : std::uint8_t {
                       // material points in both masks
 };
 
+// The velocity proxy's region (docs/dsp.md §4.2d). A drag (the in-plane part of a slide: a
+// rotation about an in-plane axis or a translation) moves the gel over the patch rigidly and
+// the gel around it less, so the density 𝒢 reads compression ahead of the patch and expansion
+// behind it, and Ω leaves the patch's leading part for the stretched gel behind it, whose shear
+// has decayed: a no-cap sphere rx 30° (`--friction 5`) read 14 % above its slow-motion value at
+// 0.5 s and 66 % above at 3 s, the same angle. Over the patch anchored before the load, the
+// shear is the patch's own, and the reading does not depend on the speed. A torsion has no
+// divergence and leaves Ω in place, while an elongated patch turns away from its anchor; a
+// translation carries the patch off its anchor. So Ω ∩ anchor is read only while the shear's
+// uniform part is at least kVelocityAnchorDragRatio times its torsion (both as rim
+// displacements, planar_content over Ω) and Ω ∩ anchor holds at least kVelocityAnchorMinOverlap
+// of the smaller of Ω and the anchor (a tilting flat face keeps a strip of its anchored face: a
+// cube's rx 30° goes from 380 to 120 cells, nearly all anchored; a translation leaves both);
+// otherwise all of Ω, as before.
+inline constexpr double kVelocityAnchorDragRatio = 1.0;
+inline constexpr double kVelocityAnchorMinOverlap = 0.5;
+
 // Per-sensor, per-frame result (sensor frame S).
 struct SensorMotion {
   bool contact = false;
   int points = 0;
-  // This frame's proxy moments, sensor frame: over Ω (velocity proxy) or over Ω_t ∩ Ω_{t−1}
-  // (displacement proxy, the cells with an increment).
+  // This frame's proxy moments, sensor frame: over Ω or Ω ∩ anchor (velocity proxy, see
+  // velocity_anchored) or over Ω_t ∩ Ω_{t−1} ∩ anchor (displacement proxy, the cells with an
+  // increment).
   ContactMoments moments;
   double proxy_scale = 0.0;  // (m/s) per Q16 LSB of the proxy in `moments`
   bool proxy_valid = false;  // false on the first displacement-mode frame after reset
@@ -115,6 +133,10 @@ struct SensorMotion {
   // or the frame a slide ended. Increments are read over Ω_t ∩ Ω_{t−1} ∩ anchor (docs/dsp.md
   // §4.2c).
   bool anchor_set = false;
+  // The velocity proxy was read over Ω ∩ anchor instead of all of Ω (every mode; docs/dsp.md
+  // §4.2d): the shear over Ω is a drag (|t| ≥ |θ|·L in planar_content, kVelocityAnchorDragRatio)
+  // and Ω and the anchor share at least kVelocityAnchorMinOverlap of the smaller one's cells.
+  bool velocity_anchored = false;
   // --- the same frame as kVelocity would have read it: the velocity proxy's moments and ω, and
   // the sliding translation rule. Differs from the reading above only while kAuto sticks
   // (velocity_differs); otherwise a copy of it. The dual pipeline fuses both readings and pays
@@ -157,7 +179,8 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 //        kVelocity this includes a centroid shift from pressing harder on a tilted object, or
 //        from pressure moving within the patch (rolling), which no rule here can tell from a
 //        slide; kAuto reads those, while the contact sticks, from the material points.
-//  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear over Ω; kDisplacement
+//  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear over Ω, or over
+//    Ω ∩ anchor while the shear is a drag and the anchor is still in Ω (above); kDisplacement
 //    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt over Ω_t ∩ Ω_{t−1}, the previous shear
 //    kept per sensor.
 //  - Rotation: int64 moments over the proxy's cells, then in double the own-frame normal
@@ -222,6 +245,7 @@ class MotionEstimator {
   // 𝒢 reads as normal load, so Ω grows over gel that does not move with the object.
   GridMask anchor_mask_;
   bool have_anchor_ = false;
+  std::int64_t anchor_count_ = 0;  // |anchor|
 
   // --- kAuto detector (Calibration fields of the same names).
   double relax_rate_on_ = 0.0;

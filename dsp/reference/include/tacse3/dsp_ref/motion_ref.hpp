@@ -60,6 +60,7 @@ struct SensorMotionRef {
   double load_drop_rate = 0.0;
   bool releasing = false;   // as dsp::SensorMotion::releasing (the chosen reading is dropped)
   bool anchor_set = false;  // as dsp::SensorMotion::anchor_set (the patch anchor is this Ω)
+  bool velocity_anchored = false;  // as dsp::SensorMotion (velocity proxy over Ω ∩ anchor)
   // The frame as kVelocity would have read it (dsp::SensorMotion's velocity_* fields).
   bool velocity_differs = false;
   std::vector<PointSample> velocity_samples;
@@ -76,7 +77,8 @@ struct SensorMotionRef {
 // `stick_confirmed` whether it confirmed a stick (the dual pipeline's slip payback reads both),
 // `releasing` whether the frame's chosen reading was dropped as a release (load falling faster
 // than release_load_rate), `anchor_set` (if `has_anchor`) whether the displacement proxy's patch
-// anchor was set to the frame's Ω (every mode; without `has_anchor` the reference decides). Used
+// anchor was set to the frame's Ω and `velocity_anchored` whether the velocity proxy read
+// Ω ∩ anchor (every mode; without `has_anchor` the reference decides both). Used
 // ONLY to measure the numeric fixed−ref difference with the
 // detector's threshold crossings taken out ("decision-locked"; docs/dsp.md).
 struct SlipDecision {
@@ -86,6 +88,7 @@ struct SlipDecision {
   bool releasing = false;
   bool has_anchor = false;
   bool anchor_set = false;
+  bool velocity_anchored = false;
 };
 
 // Same rules as dsp::MotionEstimator (translation sources, proxy modes, λ), in double.
@@ -110,6 +113,7 @@ class MotionRef {
   // The displacement proxy's patch anchor (dsp::MotionEstimator's rule).
   std::vector<std::uint8_t> anchor_;
   bool have_anchor_ = false;
+  int anchor_count_ = 0;  // |anchor|
   // kAuto detector state (dsp::MotionEstimator's, in double).
   bool slipping_ = false;
   int evidence_frames_ = 0;

@@ -39,6 +39,7 @@ class DecisionFollower {
       slip_[s].releasing = r.motion.releasing;
       slip_[s].has_anchor = true;
       slip_[s].anchor_set = r.motion.anchor_set;
+      slip_[s].velocity_anchored = r.motion.velocity_anchored;
       dsp_ref::FixedDecisions& d = out_[s];
       d.slip = levels_.slip ? &slip_[s] : nullptr;
       d.flow.valid = levels_.flow ? &f.flow_valid : nullptr;
