@@ -301,13 +301,14 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   sum_held.store(mh);
   // The velocity proxy's region (kVelocityAnchorDragRatio above): Ω ∩ anchor while the shear over
   // Ω is a drag and Ω and the anchor still share enough cells, else Ω. The ratio test is on the
-  // unscaled shear (both parts in the same units); the overlap test in exact integers.
+  // unscaled shear (both parts in the same units; strict, so a shear-free frame reads Ω); the
+  // overlap test in double, exact for cell counts.
   const Eigen::Vector3d shear_content = planar_content(mv, 1.0);
-  const bool drag = shear_content.tail<2>().norm() >=
+  const bool drag = shear_content.tail<2>().norm() >
                     kVelocityAnchorDragRatio * std::abs(shear_content.x());
+  const auto held_of = static_cast<double>(std::min(anchor_count_, m.n));
   out.velocity_anchored =
-      drag && mh.n > 0 &&
-      static_cast<double>(mh.n) >= kVelocityAnchorMinOverlap * static_cast<double>(std::min(anchor_count_, m.n));
+      drag && mh.n > 0 && static_cast<double>(mh.n) >= kVelocityAnchorMinOverlap * held_of;
   const ContactMoments& mvel = out.velocity_anchored ? mh : mv;
 
   // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
@@ -372,7 +373,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
         evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
         rest_s_ = rest ? rest_s_ + dt_s : 0.0;
         // Unloaded (|X| ≤ slip_min_shift_m, the least shift an onset needs): any slide it could be
-        // in is slower than slip_min_shift_m · c_velocity / c_displacement (≈ 0.6 mm/s with the
+        // in is slower than slip_min_shift_m · c_velocity / c_displacement (≈ 1.0 mm/s with the
         // simulator's calibration), one the detector could never call either. At rest for
         // slip_on_frames frames (the first frame of a contact counts, its change reads zero) it
         // is confirmed stuck; a loaded contact at rest may be sliding steadily at the friction

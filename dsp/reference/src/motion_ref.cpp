@@ -217,7 +217,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   out.velocity_anchored =
       release_follow != nullptr && release_follow->has_anchor
           ? release_follow->velocity_anchored
-          : shear_content.tail<2>().norm() >=
+          : shear_content.tail<2>().norm() >
                     dsp::kVelocityAnchorDragRatio * std::abs(shear_content.x()) &&
                 !held_pts.empty() &&
                 static_cast<double>(held_pts.size()) >=

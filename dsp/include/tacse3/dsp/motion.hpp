@@ -79,11 +79,11 @@ enum class TranslationSource : std::uint8_t {
 // shear is the patch's own, and the reading does not depend on the speed. A torsion has no
 // divergence and leaves Ω in place, while an elongated patch turns away from its anchor; a
 // translation carries the patch off its anchor. So Ω ∩ anchor is read only while the shear's
-// uniform part is at least kVelocityAnchorDragRatio times its torsion (both as rim
-// displacements, planar_content over Ω) and Ω ∩ anchor holds at least kVelocityAnchorMinOverlap
-// of the smaller of Ω and the anchor (a tilting flat face keeps a strip of its anchored face: a
+// uniform part exceeds kVelocityAnchorDragRatio times its torsion (the torsion as the
+// displacement on the rms lever, planar_content over Ω) and Ω ∩ anchor holds at least
+// kVelocityAnchorMinOverlap of the smaller of Ω and the anchor (a tilting flat face keeps a strip of its anchored face: a
 // cube's rx 30° goes from 380 to 120 cells, nearly all anchored; a translation leaves both);
-// otherwise all of Ω, as before.
+// otherwise all of Ω, as before (also on a frame without shear, and before the first anchor).
 inline constexpr double kVelocityAnchorDragRatio = 1.0;
 inline constexpr double kVelocityAnchorMinOverlap = 0.5;
 
@@ -134,12 +134,13 @@ struct SensorMotion {
   // §4.2c).
   bool anchor_set = false;
   // The velocity proxy was read over Ω ∩ anchor instead of all of Ω (every mode; docs/dsp.md
-  // §4.2d): the shear over Ω is a drag (|t| ≥ |θ|·L in planar_content, kVelocityAnchorDragRatio)
+  // §4.2d): the shear over Ω is a drag (|t| > |θ|·L in planar_content, kVelocityAnchorDragRatio)
   // and Ω and the anchor share at least kVelocityAnchorMinOverlap of the smaller one's cells.
   bool velocity_anchored = false;
   // --- the same frame as kVelocity would have read it: the velocity proxy's moments and ω, and
   // the sliding translation rule. Differs from the reading above only while kAuto sticks
-  // (velocity_differs); otherwise a copy of it. The dual pipeline fuses both readings and pays
+  // (velocity_differs); otherwise a copy of it. Its region follows this estimator's anchor, which
+  // kAuto also sets where a slide ends (kVelocity never does). The dual pipeline fuses both readings and pays
   // the difference back at a slip onset (SlipPayback).
   bool velocity_differs = false;
   ContactMoments velocity_moments;
@@ -180,7 +181,8 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 //        from pressure moving within the patch (rolling), which no rule here can tell from a
 //        slide; kAuto reads those, while the contact sticks, from the material points.
 //  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear over Ω, or over
-//    Ω ∩ anchor while the shear is a drag and the anchor is still in Ω (above); kDisplacement
+//    Ω ∩ anchor while the shear is a drag and Ω and the anchor share at least half the smaller
+//    one's cells (above); kDisplacement
 //    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt over Ω_t ∩ Ω_{t−1}, the previous shear
 //    kept per sensor.
 //  - Rotation: int64 moments over the proxy's cells, then in double the own-frame normal
