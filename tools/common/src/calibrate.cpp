@@ -42,6 +42,11 @@ constexpr double kJointScaleMin = 0.5, kJointScaleMax = 2.0;
 // After this many iterations the proxy assignment is frozen (the alternation may otherwise cycle
 // between two assignments); the gains then converge for that assignment.
 constexpr int kFreezeAssignmentAfter = 20;
+// The alternation stops when no gain moves by kFitConverged (relative for the proxy factors, which
+// enter as logarithms) in an iteration, or after kMaxFitIterations (the report then says how far
+// from converged: the file keeps four significant digits).
+constexpr int kMaxFitIterations = 200;
+constexpr double kFitConverged = 1e-9;
 // A recording is explained by the velocity proxy if less than this share of its velocity-proxy
 // rate persists at rest (rest_persistence).
 constexpr double kRestPersistenceMax = 0.5;
@@ -274,6 +279,8 @@ std::array<double, 3> nnls3(const Eigen::Matrix3d& M, const Eigen::Vector3d& b,
 struct FitResult {
   FitParams p;
   int iterations = 0;
+  bool converged = false;    // the last iteration changed no gain by kFitConverged or more
+  double last_change = 0.0;  // largest change of a gain in the last iteration
   std::vector<std::string> notes;
   // Per proxy and axis: the scale was fitted on that proxy's recordings (false: the axis is
   // excited by the other proxy's recordings only and takes that proxy's scale).
@@ -317,7 +324,7 @@ FitResult fit_model(const std::vector<FitData>& data, const FitParams& start) {
       excited[static_cast<std::size_t>(ax)] =
           excited[static_cast<std::size_t>(ax)] || std::abs(d.theta(ax)) >= kExciteFloorRad;
   }
-  for (int it = 0; it < 200; ++it) {
+  for (int it = 0; it < kMaxFitIterations; ++it) {
     res.iterations = it + 1;
     const FitParams before = p;
     // (1) proxy gain factor per mode.
@@ -424,7 +431,11 @@ FitResult fit_model(const std::vector<FitData>& data, const FitParams& start) {
     for (int c = 0; c < kComponents; ++c)
       delta = std::max(delta, std::abs(p.s[static_cast<std::size_t>(c)] -
                                        before.s[static_cast<std::size_t>(c)]));
-    if (!changed && delta < 1e-9) break;
+    res.last_change = delta;
+    if (!changed && delta < kFitConverged) {
+      res.converged = true;
+      break;
+    }
   }
   res.p = p;
   res.excited = excited;
@@ -643,6 +654,14 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
   }
   const FitResult fit = fit_model(data, start);
   rep.iterations = fit.iterations;
+  if (!fit.converged) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the gain fit stopped at its %d-iteration cap; the last iteration still moved a "
+                  "gain by %.2g",
+                  kMaxFitIterations, fit.last_change);
+    rep.notes.push_back(text);
+  }
   rep.shear_gains = fit.p.s;
   config::CalibrationSet fitted = base;
   for (int m = 0; m < kModes; ++m) {
