@@ -20,7 +20,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mask_growth import motion_start  # noqa: E402
+from mask_growth import motion_start_after_rest  # noqa: E402
 from torsion_increments import CELLS, load_npy  # noqa: E402
 
 
@@ -40,9 +40,7 @@ def main():
     folder, recording = sys.argv[1], sys.argv[2]
     with open(f"{folder}/index.json") as f:
         mm_per_px = float(json.load(f)["pixel_pitch_mm"])  # raw flow is in sensor pixels
-    start = motion_start(recording)
-    if start < 1:
-        sys.exit("the motion starts at the first frame: no frame before it")
+    start = motion_start_after_rest(recording)
     for pad in ("left", "right"):
         try:
             mask, shape = load_npy(f"{folder}/{pad}/mask.npy")

@@ -28,13 +28,19 @@ def motion_start(recording):
     sys.exit(f"{recording}/truth.csv: the object never moves")
 
 
+def motion_start_after_rest(recording):
+    """motion_start, which must leave at least one frame before the motion."""
+    start = motion_start(recording)
+    if start < 1:
+        sys.exit("the motion starts at the first frame: no frame before it")
+    return start
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
     folder, recording = sys.argv[1], sys.argv[2]
-    start = motion_start(recording)
-    if start < 1:
-        sys.exit("the motion starts at the first frame: no frame before it")
+    start = motion_start_after_rest(recording)
     for pad in ("left", "right"):
         try:
             mask, shape = load_npy(f"{folder}/{pad}/mask.npy")
