@@ -74,8 +74,8 @@ enum class TranslationSource : std::uint8_t {
 // rotation about an in-plane axis or a translation) moves the gel over the patch rigidly and
 // the gel around it less, so the density 𝒢 reads compression ahead of the patch and expansion
 // behind it, and Ω leaves the patch's leading part for the stretched gel behind it, whose shear
-// has decayed: a no-cap sphere rx 30° (`--friction 5`) read 14 % above its slow-motion value at
-// 0.5 s and 66 % above at 3 s, the same angle. Over the patch anchored before the load, the
+// has decayed: a no-cap sphere rx 30° (`--friction 5`) read 34.12° in 0.5 s and 49.72° in 3 s,
+// the same angle (a calibration fitted with the cap). Over the patch anchored before the load, the
 // shear is the patch's own, and the reading does not depend on the speed. A torsion has no
 // divergence and leaves Ω in place, while an elongated patch turns away from its anchor; a
 // translation carries the patch off its anchor. So Ω ∩ anchor is read only while the shear's
