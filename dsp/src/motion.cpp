@@ -299,16 +299,18 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   sum_anchored.store(ma);
   ContactMoments mh = m_held;
   sum_held.store(mh);
+  // Planar rigid content X of the shear over Ω read as a contact displacement, unsmoothed: the
+  // velocity proxy's region test below, the detector's raw X and the anchor rule all read it.
+  const Eigen::Vector3d shear_content = planar_content(mv, c_displacement_ * kQ16Lsb);
   // The velocity proxy's region (kVelocityAnchorDragRatio above): Ω ∩ anchor while the shear over
-  // Ω is a drag and Ω and the anchor still share enough cells, else Ω. The ratio test is on the
-  // unscaled shear (both parts in the same units; strict, so a shear-free frame reads Ω); the
-  // overlap test in double, exact for cell counts.
-  const Eigen::Vector3d shear_content = planar_content(mv, 1.0);
+  // Ω is a drag and Ω and the anchor still share enough cells, else Ω. The ratio test compares
+  // two parts in the same units (strict, so a shear-free frame reads Ω); the overlap test is in
+  // double, exact for cell counts.
   const bool drag = shear_content.tail<2>().norm() >
                     kVelocityAnchorDragRatio * std::abs(shear_content.x());
-  const auto held_of = static_cast<double>(std::min(anchor_count_, m.n));
+  const auto smaller_set = static_cast<double>(std::min(anchor_count_, m.n));
   out.velocity_anchored =
-      drag && mh.n > 0 && static_cast<double>(mh.n) >= kVelocityAnchorMinOverlap * held_of;
+      drag && mh.n > 0 && static_cast<double>(mh.n) >= kVelocityAnchorMinOverlap * smaller_set;
   const ContactMoments& mvel = out.velocity_anchored ? mh : mv;
 
   // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
@@ -351,7 +353,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       // started false slips in sticking contacts (3° torsion of a sphere at 1.5 mm
       // indentation read as 30°).
       const double alpha = content_alpha(dt_s, smoothing_s_);
-      const Eigen::Vector3d raw = planar_content(mv, c_displacement_ * kQ16Lsb);
+      const Eigen::Vector3d& raw = shear_content;
       const Eigen::Vector3d step = planar_content(mi, c_displacement_ * kQ16Lsb);
       content_ = have_content_ ? Eigen::Vector3d(content_ + alpha * (raw - content_)) : raw;
       change_ = have_content_ ? Eigen::Vector3d(change_ + alpha * (step - change_))
@@ -550,7 +552,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   if (m.n == 0) {
     have_anchor_ = false;
   } else if (!have_anchor_ || slide_ended ||
-             planar_content(mv, c_displacement_ * kQ16Lsb).norm() <= min_shift_m_) {
+             shear_content.norm() <= min_shift_m_) {
     anchor_mask_ = contact.mask;
     anchor_count_ = m.n;
     have_anchor_ = true;

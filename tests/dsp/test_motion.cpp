@@ -384,6 +384,27 @@ Calibration exact_displacement_cal() {
   return cal;
 }
 
+// The double reference fed the same frames: each scene's f^z and valid set, its shear, and the
+// fixed path's reported mask of that frame (so both read the same Ω). One result per frame.
+std::vector<dsp_ref::SensorMotionRef> reference_run(
+    const Calibration& cal, const std::vector<const SyntheticSensorFrames*>& scenes,
+    const std::vector<const VectorField*>& shears, const std::vector<GridMask>& masks) {
+  dsp_ref::ContactDetectorRef rdet(cal);
+  dsp_ref::MotionRef rme(cal);
+  std::vector<dsp_ref::SensorMotionRef> out;
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    std::vector<double> fz(static_cast<std::size_t>(kGridCount)), sx(fz.size()), sy(fz.size());
+    for (std::size_t i = 0; i < fz.size(); ++i) {
+      fz[i] = from_q<16>(scenes[k]->fz.v[i]);
+      sx[i] = from_q<16>(shears[k]->x.v[i]);
+      sy[i] = from_q<16>(shears[k]->y.v[i]);
+    }
+    out.push_back(
+        rme.update(rdet.detect(fz, scenes[k]->w_now, scenes[k]->valid, &masks[k]), sx, sy, kDt));
+  }
+  return out;
+}
+
 // A held tangential load stretches the gel behind the patch, and 𝒢 reads the stretch as normal
 // load: Ω grows over gel that follows the object only partly (the simulator's sphere rx 4°
 // stick: 106 cells before the motion, 315 after). The displacement proxy reads its increments
@@ -549,22 +570,12 @@ TEST(Motion, AContactThatLeftItsAnchoredCellsIsReadOverTheCellsItKept) {
   EXPECT_EQ(c.moments.n, kept);
   EXPECT_NEAR(c.omega.z(), 3.0, 3e-3);
 
-  dsp_ref::ContactDetectorRef rdet(cal);
-  dsp_ref::MotionRef rme(cal);
-  const std::array<const SyntheticSensorFrames*, 3> scenes{&fa, &fb, &fb};
-  const std::array<const VectorField*, 3> shears{&zero, loaded_b.get(), loaded_c.get()};
-  const std::array<GridMask, 3> masks{anchor, mask_b, run.cs->mask};
-  dsp_ref::SensorMotionRef r;
-  for (std::size_t k = 0; k < 3; ++k) {
-    std::vector<double> fz(static_cast<std::size_t>(kGridCount)), sx(fz.size()), sy(fz.size());
-    for (std::size_t i = 0; i < fz.size(); ++i) {
-      fz[i] = from_q<16>(scenes[k]->fz.v[i]);
-      sx[i] = from_q<16>(shears[k]->x.v[i]);
-      sy[i] = from_q<16>(shears[k]->y.v[i]);
-    }
-    r = rme.update(rdet.detect(fz, scenes[k]->w_now, scenes[k]->valid, &masks[k]), sx, sy, kDt);
-    EXPECT_EQ(r.anchor_set, k == 0) << "frame " << k;
-  }
+  const std::vector<dsp_ref::SensorMotionRef> refs =
+      reference_run(cal, {&fa, &fb, &fb}, {&zero, loaded_b.get(), loaded_c.get()},
+                    {anchor, mask_b, run.cs->mask});
+  for (std::size_t k = 0; k < refs.size(); ++k)
+    EXPECT_EQ(refs[k].anchor_set, k == 0) << "frame " << k;
+  const dsp_ref::SensorMotionRef& r = refs.back();
   EXPECT_EQ(static_cast<int>(r.samples.size()), kept);
   EXPECT_NEAR(r.omega.z(), c.omega.z(), 1e-3);
 }
@@ -648,21 +659,8 @@ TEST(Motion, ADragIsReadOverTheAnchoredPatchNotTheGelItStretched) {
       }
     }
 
-    dsp_ref::ContactDetectorRef rdet(cal);
-    dsp_ref::MotionRef rme(cal);
-    const std::array<const SyntheticSensorFrames*, 2> scenes{&fg, &fl};
-    const std::array<const VectorField*, 2> shears{&zero, shear.get()};
-    const std::array<GridMask, 2> masks{patch, run.cs->mask};
-    dsp_ref::SensorMotionRef r;
-    for (std::size_t f = 0; f < 2; ++f) {
-      std::vector<double> fz(static_cast<std::size_t>(kGridCount)), sx(fz.size()), sy(fz.size());
-      for (std::size_t i = 0; i < fz.size(); ++i) {
-        fz[i] = from_q<16>(scenes[f]->fz.v[i]);
-        sx[i] = from_q<16>(shears[f]->x.v[i]);
-        sy[i] = from_q<16>(shears[f]->y.v[i]);
-      }
-      r = rme.update(rdet.detect(fz, scenes[f]->w_now, scenes[f]->valid, &masks[f]), sx, sy, kDt);
-    }
+    const dsp_ref::SensorMotionRef r =
+        reference_run(cal, {&fg, &fl}, {&zero, shear.get()}, {patch, run.cs->mask}).back();
     EXPECT_EQ(r.velocity_anchored, b.velocity_anchored) << k.name;
     EXPECT_EQ(static_cast<int>(r.samples.size()), b.moments.n) << k.name;
     EXPECT_LT((r.omega - b.omega).norm(), 1e-4 * k.omega.norm()) << k.name;

@@ -214,23 +214,22 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   const double anchor_shift = shear_content.norm();  // |X| unsmoothed, for the anchor rule
   // The velocity proxy's region (dsp::kVelocityAnchorDragRatio's rule): Ω ∩ anchor while the
   // shear is a drag and Ω and the anchor share enough cells; the followed decision if given.
-  out.velocity_anchored =
-      release_follow != nullptr && release_follow->has_anchor
-          ? release_follow->velocity_anchored
-          : shear_content.tail<2>().norm() >
-                    dsp::kVelocityAnchorDragRatio * std::abs(shear_content.x()) &&
-                !held_pts.empty() &&
-                static_cast<double>(held_pts.size()) >=
-                    dsp::kVelocityAnchorMinOverlap *
-                    static_cast<double>(std::min(anchor_count_, out.points));
   // A followed choice the reference's own anchor cannot serve (its anchor differs) reads Ω.
-  if (held_pts.empty()) out.velocity_anchored = false;
+  const bool own_rule =
+      shear_content.tail<2>().norm() >
+          dsp::kVelocityAnchorDragRatio * std::abs(shear_content.x()) &&
+      static_cast<double>(held_pts.size()) >=
+          dsp::kVelocityAnchorMinOverlap * static_cast<double>(std::min(anchor_count_, out.points));
+  out.velocity_anchored =
+      !held_pts.empty() && (release_follow != nullptr && release_follow->has_anchor
+                                ? release_follow->velocity_anchored
+                                : own_rule);
   if (automatic) {
     if (out.points == 0) {
       reset_detector();
     } else {
       // X over Ω, its change over Ω_t ∩ Ω_{t−1} (the increments), both smoothed.
-      const Eigen::Vector3d raw = planar(shear_pts);
+      const Eigen::Vector3d& raw = shear_content;
       const Eigen::Vector3d step = planar(incr_pts);
       const double alpha = cal_.slip_smoothing_s > 0.0 ? dt / (cal_.slip_smoothing_s + dt) : 1.0;
       content_ = have_content_ ? Eigen::Vector3d(content_ + alpha * (raw - content_)) : raw;

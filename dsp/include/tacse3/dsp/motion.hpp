@@ -81,9 +81,9 @@ enum class TranslationSource : std::uint8_t {
 // translation carries the patch off its anchor. So Ω ∩ anchor is read only while the shear's
 // uniform part exceeds kVelocityAnchorDragRatio times its torsion (the torsion as the
 // displacement on the rms lever, planar_content over Ω) and Ω ∩ anchor holds at least
-// kVelocityAnchorMinOverlap of the smaller of Ω and the anchor (a tilting flat face keeps a strip of its anchored face: a
-// cube's rx 30° goes from 380 to 120 cells, nearly all anchored; a translation leaves both);
-// otherwise all of Ω, as before (also on a frame without shear, and before the first anchor).
+// kVelocityAnchorMinOverlap of the smaller of Ω and the anchor (a tilting flat face keeps a
+// strip of its anchored face: a cube's rx 30° goes from 380 to 120 cells, nearly all anchored;
+// a translation leaves both); otherwise all of Ω, as before (also on a frame without shear, and before the first anchor).
 inline constexpr double kVelocityAnchorDragRatio = 1.0;
 inline constexpr double kVelocityAnchorMinOverlap = 0.5;
 
@@ -139,9 +139,9 @@ struct SensorMotion {
   bool velocity_anchored = false;
   // --- the same frame as kVelocity would have read it: the velocity proxy's moments and ω, and
   // the sliding translation rule. Differs from the reading above only while kAuto sticks
-  // (velocity_differs); otherwise a copy of it. Its region follows this estimator's anchor, which
-  // kAuto also sets where a slide ends (kVelocity never does). The dual pipeline fuses both readings and pays
-  // the difference back at a slip onset (SlipPayback).
+  // (velocity_differs); otherwise a copy of it. Its region follows this estimator's anchor,
+  // which kAuto also sets where a slide ends (kVelocity never does). The dual pipeline fuses
+  // both readings and pays the difference back at a slip onset (SlipPayback).
   bool velocity_differs = false;
   ContactMoments velocity_moments;
   double velocity_proxy_scale = 0.0;
