@@ -8,7 +8,8 @@ library only, no NumPy) and prints, per pad:
     counts, how many of the patch's cells are still in Ω, and the mean raw flow (mm) over Ω and
     over the patch;
   - the mean raw flow summed over every frame from the motion's start (mm), over each frame's Ω
-    and over the patch, and their ratio.
+    and over the patch, and their ratio;
+  - Ω in the last frame: cell count and how many of the patch's cells it holds.
 A slide's gel shear is c·v, so its sum over the frames is proportional to the angle at any
 speed; a sum that depends on the speed shows a region that does.
 
@@ -38,8 +39,11 @@ def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
     folder, recording = sys.argv[1], sys.argv[2]
-    with open(f"{folder}/index.json") as f:
-        mm_per_px = float(json.load(f)["pixel_pitch_mm"])  # raw flow is in sensor pixels
+    try:
+        with open(f"{folder}/index.json") as f:
+            mm_per_px = float(json.load(f)["pixel_pitch_mm"])  # raw flow is in sensor pixels
+    except (OSError, ValueError, KeyError) as e:
+        sys.exit(f"{folder}/index.json: not a tacse3-replay --dump-fields folder ({e})")
     start = motion_start_after_rest(recording)
     for pad in ("left", "right"):
         try:
@@ -76,6 +80,9 @@ def main():
               f"{a:.3f} mm, over the patch {b:.3f} mm")
         print(f"{pad}: mean flow summed from frame {start}: over each Ω {so:.2f} mm, over the "
               f"patch {sp:.2f} mm, ratio {so / sp if sp > 0 else float('nan'):.3f}")
+        last = [k for k in range(CELLS) if mask[(frames - 1) * CELLS + k]]
+        print(f"{pad}: last frame {frames - 1}: Ω {len(last)} cells, "
+              f"{sum(1 for k in last if k in patch_set)} of the patch's")
 
 
 if __name__ == "__main__":

@@ -82,8 +82,9 @@ enum class TranslationSource : std::uint8_t {
 // uniform part exceeds kVelocityAnchorDragRatio times its torsion (the torsion as the
 // displacement on the rms lever, planar_content over Ω) and Ω ∩ anchor holds at least
 // kVelocityAnchorMinOverlap of the smaller of Ω and the anchor (a tilting flat face keeps a
-// strip of its anchored face: a cube's rx 30° goes from 380 to 120 cells, nearly all anchored;
-// a translation leaves both); otherwise all of Ω, as before (also on a frame without shear, and before the first anchor).
+// strip of its anchored face: a cube's rx 30° goes from 380 cells to 119, 66 of them anchored;
+// a translation leaves both); otherwise all of Ω, as before (also on a frame without shear, and
+// before the first anchor).
 inline constexpr double kVelocityAnchorDragRatio = 1.0;
 inline constexpr double kVelocityAnchorMinOverlap = 0.5;
 
