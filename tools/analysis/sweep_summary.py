@@ -20,7 +20,11 @@ STICK_DEG, STICK_MM = 5.0, 1.0
 
 def read(path):
     rows, failed = {}, []
-    with open(path) as f:
+    try:
+        f = open(path)
+    except OSError as e:
+        sys.exit(f"{path}: cannot read ({e.strerror})")
+    with f:
         for line in f:
             parts = line.split()
             if not parts or parts[0] in ("real", "user", "sys"):
