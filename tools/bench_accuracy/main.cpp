@@ -232,6 +232,7 @@ int main(int argc, char** argv) {
   bool quick = false;
   int jobs = 2;
   std::string markdown, cal_out, cal_in;
+  double friction = 0.0;
   app.add_flag("--quick", quick, "a reduced set (a few recordings per table)");
   app.add_option("-j,--jobs", jobs, "recordings simulated and evaluated in parallel (default 2)")
       ->check(CLI::Range(1, 64));
@@ -239,6 +240,10 @@ int main(int argc, char** argv) {
   app.add_option("--calibration-out", cal_out, "write the fitted calibration to this file");
   app.add_option("--calibration", cal_in,
                  "skip the calibration stage and use this calibration file");
+  app.add_option("--friction", friction,
+                 "simulate every recording (calibration and test) with this object-gel "
+                 "friction coefficient instead of each preset's (5: no friction cap in practice)")
+      ->check(CLI::Range(0.01, 5.0));
   CLI11_PARSE(app, argc, argv);
 
   const auto t0 = std::chrono::steady_clock::now();
@@ -249,7 +254,8 @@ int main(int argc, char** argv) {
   // ---- calibration ------------------------------------------------------------------------
   tacse3::config::CalibrationSet cal;
   tt::CalibrateReport cal_report;
-  const std::vector<SimCase> cal_cases = calibration_set(quick);
+  std::vector<SimCase> cal_cases = calibration_set(quick);
+  for (auto& c : cal_cases) c.friction = friction;
   if (!cal_in.empty()) {
     if (auto s = tacse3::config::load_calibration(cal_in, &cal); !s) {
       std::fprintf(stderr, "tacse3-bench-accuracy: error: %s\n", s.message().c_str());
@@ -277,6 +283,7 @@ int main(int argc, char** argv) {
 
   // ---- evaluation ---------------------------------------------------------------------------
   std::vector<Row> rows = test_rows(quick);
+  for (auto& r : rows) r.c.friction = friction;
   std::int64_t total = 0;
   for (const auto& r : rows) total += tt::case_frames(r.c);
   std::fprintf(stderr, "tacse3-bench-accuracy: evaluating %zu simulated test recordings\n",
@@ -331,6 +338,13 @@ int main(int argc, char** argv) {
                 std::chrono::duration<double>(t1 - t0).count(),
                 std::chrono::duration<double>(t2 - t1).count(), jobs);
   add(line);
+  if (friction > 0.0) {
+    std::snprintf(line, sizeof(line),
+                  "Friction: every recording (calibration and test) simulated with object-gel "
+                  "friction %g (`--friction`) instead of each preset's.",
+                  friction);
+    add(line);
+  }
   add(std::string("Default mode `auto`: ") +
       (tt::pipeline_has_auto() ? "the pipeline's per-frame stick/slip switch."
                                : "the pipeline has no stick/slip switch yet, so `auto` runs the "

@@ -33,6 +33,10 @@ std::string SimCase::sim_arguments() const {
     std::snprintf(buf, sizeof(buf), " --indentation %g", indentation_mm);
     s += buf;
   }
+  if (friction > 0.0) {
+    std::snprintf(buf, sizeof(buf), " --friction %g", friction);
+    s += buf;
+  }
   if (hold_s != 0.4 || approach_s != 0.1 || grasp_s != 0.4 || settle_s != 0.1) {
     std::snprintf(buf, sizeof(buf), " --approach-s %g --grasp-s %g --settle-s %g --hold-s %g",
                   approach_s, grasp_s, settle_s, hold_s);
@@ -61,6 +65,7 @@ std::string make_sim_config(const SimCase& c, sim::SimConfig* out) {
   cfg.scenario.hold_s = c.hold_s;
   cfg.scenario.release_s = c.release_s;
   if (c.radius_mm > 0.0) cfg.scenario.object.size_mm = c.radius_mm;
+  if (c.friction > 0.0) cfg.scenario.object.friction = c.friction;
   if (std::string e = sim::validate(cfg); !e.empty()) return c.label() + ": " + e;
   *out = cfg;
   return {};
