@@ -578,4 +578,26 @@ TEST(Accuracy, TheVelocityProxyReadsAnInPlaneSlideAtAnySpeed) {
   EXPECT_NEAR(read[0] / read[1], 1.0, 0.03);
 }
 
+// Without the friction cap the pipeline reads an in-plane rotation with one gain at any angle,
+// so the benchmark's 60° and 90° shortfall is the cap's (docs/accuracy.md item 2 (e)): the same
+// sphere turned 30° (in 1 s) and 90° (in 2 s, 1.5 times the peak speed) about x with
+// --friction 5, defaults (joint, auto), must read the same per degree. Measured 41.11° and
+// 123.57° with the committed calibration (fitted with the cap, hence above the angle): per
+// degree 1.370 and 1.373. With the preset friction the two read 30.73° and 69.08°.
+TEST(Accuracy, WithoutTheFrictionCapThirtyAndNinetyDegreesReadWithOneGain) {
+  const tacse3::config::CalibrationSet cal = committed_calibration();
+  double per_degree[2] = {0.0, 0.0};
+  const double angle[2] = {30.0, 90.0};
+  for (int k = 0; k < 2; ++k) {
+    tt::SimCase c = sim_case("sphere", "rx", angle[k], 1, 0);
+    c.friction = 5.0;
+    const tt::PoseErrors e = replay_errors(c, cal);
+    per_degree[k] = e.estimated_rotation_deg / angle[k];
+    std::printf("%s: %.2f deg, %.3f per degree\n", c.sim_arguments().c_str(),
+                e.estimated_rotation_deg, per_degree[k]);
+  }
+  ASSERT_GT(per_degree[0], 0.5);
+  EXPECT_NEAR(per_degree[1] / per_degree[0], 1.0, 0.03);
+}
+
 }  // namespace
