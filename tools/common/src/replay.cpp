@@ -129,8 +129,9 @@ std::string make_setup(const SourceInfo& info, const ReplayOptions& options, Eng
   for (std::size_t k = 0; k < 2; ++k) {
     dsp::Calibration& c = s.cal[k];
     // The rig's pixel pitch replaces the calibration's. The proxy gains are metres (per second)
-    // per pixel of shear, so they scale with the pitch: a file calibrated at one pitch stays
-    // right on a rig with another.
+    // per pixel of shear, so they scale with the pitch. That keeps the units; the grid and the
+    // smoothing are in pixels, so a slide still reads a few per cent differently at another
+    // pitch (docs/replay.md).
     const double ratio = pitch_m / c.pixel_pitch_m;
     c.pixel_pitch_m = pitch_m;
     c.c_velocity *= ratio;
