@@ -77,6 +77,9 @@ struct Runner {
   std::array<long, 2> locked_switches{}, fixed_switches{};
   // Accumulated diagnostics.
   long slip_mismatch = 0, frames_contact = 0, mask_mismatch_cells = 0, mask_cells = 0;
+  // The region choices of dsp/src/motion.cpp (docs/dsp.md §4.2c, §4.2d): which sensor-frames set
+  // the displacement proxy's anchor, and which read the velocity proxy over Ω ∩ anchor.
+  long anchor_set_mismatch = 0, velocity_anchored_mismatch = 0;
   FieldDiff flow, smoothed, d, r, k, shear, shear_in_contact, fz, density;
   long flow_valid_mismatch = 0, smoothed_valid_mismatch = 0, cells = 0;
   // Stages in isolation: the double stage fed with the fixed stage's own input.
@@ -331,6 +334,10 @@ int main(int argc, char** argv) {
         if (fr.motion.contact || rm.contact) {
           ++r.frames_contact;
           if (fr.motion.slipping != rm.slipping) ++r.slip_mismatch;
+          if (fr.motion.anchor_set != rm.anchor_set) ++r.anchor_set_mismatch;
+          if (fr.motion.velocity_anchored != rm.velocity_anchored) {
+            ++r.velocity_anchored_mismatch;
+          }
         }
       }
       if (r.csv != nullptr) {
@@ -362,6 +369,10 @@ int main(int argc, char** argv) {
         r.slip_mismatch, r.frames_contact, r.mask_mismatch_cells, r.mask_cells, r.flow.rms(),
         r.flow.snr_db(), r.smoothed.snr_db(), r.d.snr_db(), r.r.snr_db(), r.k.snr_db(),
         r.shear.snr_db(), r.shear_in_contact.rms(), r.shear_in_contact.snr_db(), r.fz.snr_db());
+    std::printf(
+        "              region choices differing (sensor-frames in contact): anchor set %ld, "
+        "velocity proxy over the anchored patch %ld\n",
+        r.anchor_set_mismatch, r.velocity_anchored_mismatch);
     std::printf(
         "              stage SNR over points valid in both: flow %.1f dB, smoothed %.1f, "
         "density %.1f, d %.1f, r %.1f, k %.1f, shear %.1f, fz %.1f; validity mismatches: "
