@@ -45,7 +45,7 @@ tt::SimCase sim_case(const char* object, const char* motion, double magnitude, s
 }
 
 // Changes the case's simulator configuration before rendering (settings tacse3-sim has and
-// SimCase does not carry: friction, motion duration).
+// SimCase does not carry, such as the motion's duration).
 using SimAlteration = std::function<void(tacse3::sim::SimConfig&)>;
 
 // The case rendered in memory, frame by frame (grey, like the benchmark); nullptr and *err set
@@ -564,12 +564,11 @@ TEST(Accuracy, TheVelocityProxyReadsAnInPlaneSlideAtAnySpeed) {
   double read[2] = {0.0, 0.0};
   const double motion_s[2] = {0.5, 2.0};
   for (int k = 0; k < 2; ++k) {
-    const tt::PoseErrors e = replay_errors(
-        sim_case("sphere", "rx", 30, 1, 0), cal, tt::ProxyMode::kVelocity,
-        [&](tacse3::sim::SimConfig& sc) {
-          sc.scenario.object.friction = 5.0;
-          sc.scenario.motion_s = motion_s[k];
-        });
+    tt::SimCase c = sim_case("sphere", "rx", 30, 1, 0);
+    c.friction = 5.0;
+    const tt::PoseErrors e =
+        replay_errors(c, cal, tt::ProxyMode::kVelocity,
+                      [&](tacse3::sim::SimConfig& sc) { sc.scenario.motion_s = motion_s[k]; });
     read[k] = e.estimated_rotation_deg;
     std::printf("sphere rx 30 deg in %.1f s, friction 5, --mode velocity: %.2f deg\n",
                 motion_s[k], read[k]);

@@ -1,11 +1,15 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-# tools tests: tools/analysis/friction_cap_bound.py against the slide law's closed-form solution.
-"""A rotation about G x at a constant rate from rest of the shear: the pad centre slides at
-v = w W/2, the shear U(t) = c v (1 - exp(-t/tau)) reaches the cap m at t* = -tau ln(1 - m/(c v))
-and is held there, so the motion beyond the cap speed is (v - m/c)(T - t*). Also: a rotation
-slow enough to stay below the cap (0), a torsion (the centre does not slide: 0) and a folder that
-is not a simulator recording (a clear error, exit status 1).
+# tools tests: tools/analysis/friction_cap_bound.py against the slide law's closed form.
+"""The deepest point of each pad (the object's surface at z = +-(W/2 + d)) sliding at a constant
+speed v from rest of the shear: U(t) = c v (1 - exp(-t/tau)) reaches the cap m = mu kappa d at
+t* = -tau ln(1 - m/(c v)) and is held there, so the motion beyond the cap speed is
+(v - m/c)(T - t*), and for a rotation that over the lever W/2 + d in degrees. Three motions give
+v = 30 mm/s: a rotation about G x, a translation along G y (truth in metres), and a torsion about
+a vertical axis 5 mm off the grasp centre (v = 5 mm * w; it catches a wrong sign or unit of the
+truth's position). Also: a rotation slow enough to stay below the cap (0), a torsion about the
+centre (the deepest point does not slide: 0), and clear errors (exit 1) for a folder that is not
+a simulator recording, a stick recording and a non-finite truth value.
 
 Usage: test_friction_cap_bound.py SCRIPT
 """
@@ -18,66 +22,108 @@ import sys
 import tempfile
 
 FPS, W, C, TAU, MU, KAPPA, D = 120, 38.0, 0.05, 0.06, 0.6, 1.5, 1.0
+LEVER = W / 2 + D
 
 
-def write_recording(path, axis, rate, seconds):
+def axis_rotation(axis, angle):
+    q = [math.cos(angle / 2), 0.0, 0.0, 0.0]
+    q[1 + axis] = math.sin(angle / 2)
+    return q
+
+
+def write_recording(path, pose_at, seconds, regime="slide", unit="deg"):
+    """pose_at(t) -> (quaternion [w, x, y, z], position in metres)."""
     os.makedirs(path)
-    sim = {"object": "sphere", "friction": MU, "indentation_mm": D,
-           "motion": {"axis": "r" + "xyz"[axis], "magnitude": 1.0, "unit": "deg"},
+    sim = {"object": "sphere", "friction": MU, "indentation_mm": D, "regime": regime,
+           "motion": {"axis": "synthetic", "magnitude": 1.0, "unit": unit},
            "gel": {"drag_time_s": C, "lag_time_s": TAU, "shear_compliance": KAPPA}}
     meta = {"format": "tacse3-recording", "version": 1, "width": 320, "height": 240, "fps": FPS,
             "sensors": ["left", "right"],
             "rig": {"pixel_pitch_mm": 0.1, "finger_separation_mm": W, "layout": "mirrored"},
             "sim": sim}
-    json.dump(meta, open(f"{path}/recording.json", "w"))
+    with open(f"{path}/recording.json", "w") as f:
+        json.dump(meta, f)
     with open(f"{path}/truth.csv", "w") as f:
         f.write("t_ns,qw,qx,qy,qz,px,py,pz\n")
         for k in range(int(seconds * FPS) + 1):
             t = k / FPS
-            h = rate * t / 2
-            q = [math.cos(h), 0.0, 0.0, 0.0]
-            q[1 + axis] = math.sin(h)
-            f.write(f"{round(t * 1e9)},{q[0]!r},{q[1]!r},{q[2]!r},{q[3]!r},0,0,0\n")
+            q, p = pose_at(t)
+            f.write(f"{round(t * 1e9)}," + ",".join(repr(x) for x in q + p) + "\n")
 
 
-def unseen_mm(script, path):
-    out = subprocess.run([sys.executable, script, path], capture_output=True, text=True)
+def run(script, path):
+    return subprocess.run([sys.executable, script, path], capture_output=True, text=True)
+
+
+def read_pads(script, path):
+    """[(pad, mm, deg or None)] from the script's per-pad lines."""
+    out = run(script, path)
     if out.returncode != 0:
         sys.exit(f"FAIL: {path}: exit {out.returncode}: {out.stderr}")
-    found = re.findall(r"motion beyond the cap speed ([0-9.]+) mm", out.stdout)
+    found = re.findall(r"(left|right) pad.*motion beyond the cap speed ([0-9.]+) mm"
+                       r"(?: = ([0-9.]+) deg)?", out.stdout)
     if len(found) != 2:
         sys.exit(f"FAIL: {path}: unexpected output:\n{out.stdout}")
-    return [float(x) for x in found]
+    return [(pad, float(mm), float(deg) if deg else None) for pad, mm, deg in found]
 
 
 def main():
     script = sys.argv[1]
     failures = 0
+
+    def check(ok, what):
+        nonlocal failures
+        failures += not ok
+        print(f"{'ok' if ok else 'FAIL'}: {what}")
+
     with tempfile.TemporaryDirectory() as tmp:
-        cap = MU * KAPPA * D
-        v = 30.0  # mm/s at the pad centre
-        write_recording(f"{tmp}/fast", 0, v / (W / 2), 1.0)
+        cap, v = MU * KAPPA * D, 30.0
         t_star = -TAU * math.log(1.0 - cap / (C * v))
         expected = (v - cap / C) * (1.0 - t_star)
-        for got in unseen_mm(script, f"{tmp}/fast"):
-            ok = abs(got - expected) < 0.02
-            failures += not ok
-            print(f"{'ok' if ok else 'FAIL'}: rx at {v} mm/s: {got:.3f} mm, closed form {expected:.3f}")
-        write_recording(f"{tmp}/slow", 1, 15.0 / (W / 2), 1.0)  # c v = 0.75 mm < 0.9 mm
-        write_recording(f"{tmp}/torsion", 2, 3.0, 1.0)
-        for name in ("slow", "torsion"):
-            for got in unseen_mm(script, f"{tmp}/{name}"):
-                ok = got == 0.0
-                failures += not ok
-                print(f"{'ok' if ok else 'FAIL'}: {name}: {got:.3f} mm, expected 0")
+        w_x = v / LEVER
+        w_off, off_mm = v / 5.0, 5.0
+
+        def offset_torsion(t):
+            # A turn about the vertical axis through (5, 0, 0) mm: p = (I - R) a, in metres.
+            a = w_off * t
+            return (axis_rotation(2, a),
+                    [off_mm * (1 - math.cos(a)) * 1e-3, -off_mm * math.sin(a) * 1e-3, 0.0])
+
+        cases = {"rotation about x": (lambda t: (axis_rotation(0, w_x * t), [0.0, 0.0, 0.0]),
+                                      "deg", LEVER),
+                 "translation along y": (lambda t: ([1.0, 0.0, 0.0, 0.0], [0.0, v * t * 1e-3, 0.0]),
+                                         "mm", None),
+                 "torsion about an axis 5 mm off the centre": (offset_torsion, "deg", LEVER)}
+        for i, (name, (pose_at, unit, lever)) in enumerate(cases.items()):
+            write_recording(f"{tmp}/c{i}", pose_at, 1.0, unit=unit)
+            for pad, mm, deg in read_pads(script, f"{tmp}/c{i}"):
+                check(abs(mm - expected) < 0.02,
+                      f"{name}, {pad} pad: {mm:.3f} mm, closed form {expected:.3f}")
+                if lever:
+                    want = math.degrees(mm / lever)
+                    check(deg is not None and abs(deg - want) < 0.01,
+                          f"{name}, {pad} pad: {deg} deg, {mm:.3f} mm over {lever:g} mm = {want:.2f}")
+        slow = (lambda t: (axis_rotation(1, 15.0 / LEVER * t), [0.0, 0.0, 0.0]))  # c v = 0.75 mm
+        centred = (lambda t: (axis_rotation(2, 3.0 * t), [0.0, 0.0, 0.0]))
+        for name, pose_at in (("slow rotation about y", slow), ("torsion about the centre", centred)):
+            path = f"{tmp}/{name.replace(' ', '_')}"
+            write_recording(path, pose_at, 1.0)
+            for pad, mm, _ in read_pads(script, path):
+                check(mm == 0.0, f"{name}, {pad} pad: {mm:.3f} mm, expected 0")
+
+        # Clear errors.
         os.makedirs(f"{tmp}/plain")
-        json.dump({"format": "tacse3-recording"}, open(f"{tmp}/plain/recording.json", "w"))
-        out = subprocess.run([sys.executable, script, f"{tmp}/plain"], capture_output=True,
-                             text=True)
-        ok = out.returncode == 1 and "not a tacse3-sim recording" in out.stderr
-        failures += not ok
-        print(f"{'ok' if ok else 'FAIL'}: a recording without the simulator block: "
-              f"exit {out.returncode}, {out.stderr.strip()}")
+        with open(f"{tmp}/plain/recording.json", "w") as f:
+            json.dump({"format": "tacse3-recording"}, f)
+        write_recording(f"{tmp}/stick", slow, 1.0, regime="stick")
+        write_recording(f"{tmp}/nan", lambda t: (axis_rotation(0, t), [0.0, float("nan"), 0.0]),
+                        1.0)
+        for path, message in ((f"{tmp}/plain", "not a tacse3-sim recording"),
+                              (f"{tmp}/stick", "only the slide regime has a friction cap"),
+                              (f"{tmp}/nan", "truth.csv:2: a value is not finite")):
+            out = run(script, path)
+            check(out.returncode == 1 and message in out.stderr,
+                  f"{os.path.basename(path)}: exit {out.returncode}, {out.stderr.strip()}")
     sys.exit(1 if failures else 0)
 
 

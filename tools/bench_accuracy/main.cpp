@@ -242,7 +242,8 @@ int main(int argc, char** argv) {
                  "skip the calibration stage and use this calibration file");
   app.add_option("--friction", friction,
                  "simulate every recording (calibration and test) with this object-gel "
-                 "friction coefficient instead of each preset's (5: no friction cap in practice)")
+                 "friction coefficient instead of each preset's (5: the cap is far above the shear "
+                 "but for a thin rim of the patch)")
       ->check(CLI::Range(0.01, 5.0));
   CLI11_PARSE(app, argc, argv);
 
@@ -340,9 +341,9 @@ int main(int argc, char** argv) {
   add(line);
   if (friction > 0.0) {
     std::snprintf(line, sizeof(line),
-                  "Friction: every recording (calibration and test) simulated with object-gel "
-                  "friction %g (`--friction`) instead of each preset's.",
-                  friction);
+                  "Friction: every %s recording simulated with object-gel friction %g "
+                  "(`--friction`) instead of each preset's.",
+                  cal_in.empty() ? "calibration and test" : "test", friction);
     add(line);
   }
   add(std::string("Default mode `auto`: ") +
