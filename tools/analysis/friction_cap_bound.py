@@ -12,17 +12,21 @@ indentation. The pads are force-controlled, so the deepest point is the object's
 z = +-(W/2 + d) on the grasp axis: W/2 + d is the lever of a rotation about the grasp centre
 (exact for a centred sphere; for shapes whose height changes as they turn, an approximation).
 While the shear is held at the cap it reads as if the surface moved at cap / c, so the motion
-beyond that speed leaves no trace in the shear: the script sums it (mm) and, for a rotation,
-turns it into degrees with the lever.
+beyond that speed leaves no trace in the shear: the script sums it (mm) and, for a rotation
+about an in-plane axis (rx, ry), turns it into degrees with the lever.
 
-Why this bounds what a reading of the whole patch misses, in an in-plane rotation (rx, ry) or a
-translation (tx, ty): a cell where the object is d' deep slides at v - omega (d - d') (the same v
-in a translation) and its cap is mu kappa d', so the speed it cannot show exceeds the deepest
-point's by (d - d') (mu kappa / c - omega) >= 0 while omega < mu kappa / c (18 rad/s at the
-preset). No estimator that reads the shear, without a prior on the motion, recovers it. In a
+Why this bounds what the shear of the whole patch cannot show, in an in-plane rotation (rx, ry)
+or a translation (tx, ty): a cell where the object is d' deep slides at v - omega (d - d') (the
+same v in a translation) and its cap is mu kappa d', so the speed it cannot show exceeds the
+deepest point's by (d - d') (mu kappa / c - omega) >= 0 while omega < mu kappa / c (18 rad/s at
+the preset); and it is capped whenever the deepest point is (its shear plus mu kappa (d - d')
+follows the same capped law with a drive of at least c v). No estimator that reads the shear,
+without a prior on the motion, recovers it. (The pipeline reads a slide's translation from the
+mask centroid, not from the shear.) In a
 torsion (rz) the deepest point of a centred object does not slide and the figure is 0: it says
-nothing there. The ODE is solved exactly per sub-step with the cap applied after each, as the
-simulator does (it takes sub-steps of at most tau/4; --substeps per frame interval here).
+nothing there. The ODE is solved exactly per sub-step for the frame interval's mean velocity,
+with the cap applied after each sub-step (--substeps per frame interval; the simulator takes
+sub-steps of at most tau/4 with the twist at their midpoint, one per frame at 120 fps).
 
 Usage: friction_cap_bound.py REC_DIR [--substeps 20]
 """
@@ -77,7 +81,8 @@ def load(rec):
     if not isinstance(sim, dict) or not isinstance(sim.get("gel"), dict):
         fail(f"{rec}: recording.json has no simulator block (not a tacse3-sim recording)")
     if sim.get("regime") != "slide":
-        fail(f"{rec}: regime {sim.get('regime')!r}: only the slide regime has a friction cap")
+        fail(f"{rec}: recording.json's sim.regime is {sim.get('regime', 'missing')!r}: only the "
+             f"slide regime has a friction cap")
     try:
         gel = sim["gel"]
         prm = {"c": positive(gel["drag_time_s"], "gel.drag_time_s"),
@@ -155,7 +160,7 @@ def main():
     cap = prm["mu"] * prm["kappa"] * prm["d"]
     lever = prm["w"] / 2.0 + prm["d"]
     motion = prm["motion"]
-    rotation = motion.get("unit") == "deg"
+    in_plane_rotation = motion.get("axis") in ("rx", "ry")
     print(f"{args.rec}: {prm['object']} {motion.get('axis')} {motion.get('magnitude')} "
           f"{motion.get('unit')}, friction {prm['mu']:g}, cap mu*kappa*d = {cap:.3f} mm at the "
           f"deepest point, shear at the cap for a surface speed of {cap / prm['c']:.2f} mm/s")
@@ -163,7 +168,7 @@ def main():
         peak, capped_s, unseen = unseen_at(z, prm, truth, args.substeps)
         line = (f"  {name} pad, deepest point: peak surface speed {peak:.2f} mm/s, at the cap "
                 f"for {capped_s:.3f} s, motion beyond the cap speed {unseen:.3f} mm")
-        if rotation:
+        if in_plane_rotation:
             line += (f" = {math.degrees(unseen / lever):.2f} deg of rotation "
                      f"(lever {lever:g} mm)")
         print(line)
