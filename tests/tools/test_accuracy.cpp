@@ -555,10 +555,11 @@ TEST(Accuracy, ATwoDegreeStickRotationFitsItsAxisForTheDisplacementProxy) {
 // The velocity proxy reads a slide about an in-plane axis at any speed with the same gain
 // (docs/dsp.md §4.2d). Without the friction cap (--friction 5: the gel's shear is c·v at every
 // speed but on a thin rim of the patch, and its integral over the motion is c times the angle),
-// the same 30° about x in 0.5 s and in 2 s must read the same. Before the velocity proxy read a drag over the anchored patch, Ω
-// left the patch for the stretched gel behind it the more the faster the slide, and the two read
-// 34.1° and 46.1° (0.74 apart, uncalibrated for this friction); measured since: 61.40° and
-// 61.41° with stop 19's calibration, 41.07° and 41.00° with the refit of accuracy.md item 16.
+// the same 30° about x in 0.5 s and in 2 s must read the same. Before the velocity proxy read a
+// drag over the anchored patch, Ω left the patch for the stretched gel behind it the more the
+// faster the slide, and the two read 34.1° and 46.1° (0.74 apart, uncalibrated for this
+// friction); measured since: 61.40° and 61.41° with stop 19's calibration, 41.07° and 41.00°
+// with the refit of accuracy.md item 16.
 TEST(Accuracy, TheVelocityProxyReadsAnInPlaneSlideAtAnySpeed) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   double read[2] = {0.0, 0.0};

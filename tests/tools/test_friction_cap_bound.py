@@ -7,10 +7,11 @@ t* = -tau ln(1 - m/(c v)) and is held there, so the motion beyond the cap speed 
 (v - m/c)(T - t*), and for a rotation that over the lever W/2 + d in degrees. Three motions give
 v = 30 mm/s: a rotation about G x, a translation along G y (truth in metres), and a torsion about
 an axis parallel to the grasp axis G z, 5 mm off it (v = 5 mm * w; it catches a wrong sign or
-unit of the truth's position). Only the rotation about x is also given in degrees. Also: a rotation slow enough to stay below the cap (0), a torsion about the
-centre (the deepest point does not slide: 0), and clear errors (exit 1) for a folder that is not
-a simulator recording, a stick recording, a missing key, a non-finite truth value and a truth
-whose time does not increase.
+unit of the truth's position). Only the rotation about x is also given in degrees. Also: a
+rotation slow enough to stay below the cap (0), a torsion about the centre (the deepest point
+does not slide: 0), and clear errors (exit 1) for a folder that is not a simulator recording, a
+stick recording, a missing key, a non-finite truth value and a truth whose time does not
+increase.
 
 Usage: test_friction_cap_bound.py SCRIPT
 """
@@ -103,12 +104,14 @@ def main():
                 if lever:
                     want = math.degrees(mm / lever)
                     check(deg is not None and abs(deg - want) < 0.01,
-                          f"{name}, {pad} pad: {deg} deg, {mm:.3f} mm over {lever:g} mm = {want:.2f}")
+                          f"{name}, {pad} pad: {deg} deg, {mm:.3f} mm over {lever:g} mm "
+                          f"= {want:.2f}")
                 else:
                     check(deg is None, f"{name}, {pad} pad: no figure in degrees ({deg})")
         slow = (lambda t: (axis_rotation(1, 15.0 / LEVER * t), [0.0, 0.0, 0.0]))  # c v = 0.75 mm
         centred = (lambda t: (axis_rotation(2, 3.0 * t), [0.0, 0.0, 0.0]))
-        for name, pose_at in (("slow rotation about y", slow), ("torsion about the centre", centred)):
+        for name, pose_at in (("slow rotation about y", slow),
+                              ("torsion about the centre", centred)):
             path = f"{tmp}/{name.replace(' ', '_')}"
             write_recording(path, pose_at, 1.0)
             for pad, mm, _ in read_pads(script, path):

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-# tacse3 tools: what a slide's shear reads over the deepest part of the patch (accuracy.md item 2 (f)).
+# tacse3 tools: a slide's shear over the deepest part of the patch (accuracy.md item 2 (f)).
 """Reads a `tacse3-replay --dump-fields DIR` folder and the recording's truth.csv (standard
 library only, no NumPy) and prints, per pad, the calibrated shear (f^x, f^y) averaged over a
 region of the patch and summed over the frames from the motion's start, per degree of the

@@ -50,8 +50,9 @@ def summary(label, rows, failed):
     slides = [(e, t, n) for n, (s, e, t) in rows.items() if not s]
     worst = max(sticks) if sticks else (float("nan"), "-")
     print(f"{label}: {len(rows)} recordings, {len(failed)} failed {failed if failed else ''}")
+    under = sum(1 for e, _ in sticks if e < 0.2)
     print(f"  sticks {len(sticks)}: worst {worst[0]:.2f} deg ({worst[1]}), sum "
-          f"{sum(e for e, _ in sticks):.2f} deg, {sum(1 for e, _ in sticks if e < 0.2)} under 0.2 deg")
+          f"{sum(e for e, _ in sticks):.2f} deg, {under} under 0.2 deg")
     print(f"  slides {len(slides)}: rotation errors summed {sum(e for e, _, _ in slides):.2f} deg, "
           f"translation errors summed {sum(t for _, t, _ in slides):.2f} mm")
 

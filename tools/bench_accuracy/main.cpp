@@ -241,9 +241,9 @@ int main(int argc, char** argv) {
   app.add_option("--calibration", cal_in,
                  "skip the calibration stage and use this calibration file");
   app.add_option("--friction", friction,
-                 "simulate every recording the run renders (calibration and test) with this object-gel "
-                 "friction coefficient instead of each preset's (5: the cap is far above the shear "
-                 "but for a thin rim of the patch)")
+                 "simulate every recording the run renders (calibration and test) with this "
+                 "object-gel friction coefficient instead of each preset's (5: the cap is far "
+                 "above the shear but for a thin rim of the patch)")
       ->check(CLI::Range(0.01, 5.0));
   CLI11_PARSE(app, argc, argv);
 
