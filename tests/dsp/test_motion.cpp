@@ -644,6 +644,7 @@ TEST(Motion, ADragIsReadOverTheAnchoredPatchNotTheGelItStretched) {
     ASSERT_GT(ring, 20) << k.name;
     EXPECT_EQ(b.velocity_anchored, k.anchored) << k.name;
     EXPECT_EQ(b.moments.n, k.anchored ? held : b.points) << k.name;
+    EXPECT_EQ(b.velocity_points, b.moments.n) << k.name;
     if (k.anchored) {
       // Exact over the anchored cells; over all of Ω the halved ring would dilute it.
       EXPECT_LT((b.omega - k.omega).norm(), 1e-3 * k.omega.norm()) << k.name;
