@@ -313,6 +313,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       drag && mh.n > 0 && static_cast<double>(mh.n) >= kVelocityAnchorMinOverlap * smaller_set;
   const ContactMoments& mvel = out.velocity_anchored ? mh : mv;
   out.velocity_points = static_cast<int>(mvel.n);
+  out.anchor_overlap_points = static_cast<int>(mh.n);
 
   // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
   // and its relative rate of fall ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) · Δt), EMA the

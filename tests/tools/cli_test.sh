@@ -60,14 +60,19 @@ rel_frames=$(($(wc -l < "$T/rel/frames.csv") - 1))
 t_release=$(tail -1 "$T/rel/frames.csv" | awk -F, '{ print $2 + 8333333 - 200000000 }')
 "$REPLAY" "$T/rel" --out "$T/rel.csv" --slip-log "$T/slip.csv" -q
 check "replay --slip-log exits 0" test $? -eq 0
-check "slip log header" test "$(head -1 "$T/slip.csv")" = \
-  "t_ns,sensor,contact,slipping,onset,stick_confirmed,relax_rate_per_s,shift_m,rate_m_s,load_drop_per_s,releasing,anchor_set,velocity_anchored,points,velocity_points"
+slip_header="t_ns,sensor,contact,slipping,onset,stick_confirmed,relax_rate_per_s,shift_m,rate_m_s"
+slip_header="$slip_header,load_drop_per_s,releasing,anchor_set,velocity_anchored,points"
+slip_header="$slip_header,velocity_points,anchor_overlap_points"
+check "slip log header" test "$(head -1 "$T/slip.csv")" = "$slip_header"
 check "slip log: a row per sensor and frame" test "$(($(wc -l < "$T/slip.csv") - 1))" -eq $((2 * rel_frames))
-# The velocity proxy's region: Ω (velocity_points = points) unless it read Ω ∩ anchor (fewer or
-# as many cells); a contact's first frame anchors, and there is no region without contact.
-awk -F, 'NR > 1 { if ($3 == 1 && !was[$2]) { first[$2]++; if ($12 != 1) bad++ }
+# The velocity proxy's region: Ω (velocity_points = points) unless it read Ω ∩ anchor
+# (velocity_points = anchor_overlap_points ≤ points); a contact's first frame has no anchor yet
+# and sets it (this recording has no frame the pipeline rejects, which keeps the anchor), and
+# there is no region without contact.
+awk -F, 'NR > 1 { if ($3 == 1 && !was[$2]) { first[$2]++; if ($12 != 1 || $16 != 0) bad++ }
                   was[$2] = $3
-                  if ($15 > $14 || ($13 == 0 && $15 != $14) || ($3 == 0 && $14 != 0)) bad++ }
+                  if ($15 > $14 || $16 > $14 || ($13 == 0 && $15 != $14) ||
+                      ($13 == 1 && $15 != $16) || ($3 == 0 && $14 + $16 != 0)) bad++ }
   END { exit !(first["left"] >= 1 && first["right"] >= 1 && bad == 0) }' "$T/slip.csv"
 check "slip log: anchor set on first contact, velocity region within Omega" test $? -eq 0
 awk -F, -v t0="$t_release" 'NR > 1 && $11 == 1 { n[$2]++; if ($1 < t0 || $10 <= 4) bad++ }

@@ -102,19 +102,19 @@ int main(int argc, char** argv) {
     std::fprintf(slip,
                  "t_ns,sensor,contact,slipping,onset,stick_confirmed,relax_rate_per_s,shift_m,"
                  "rate_m_s,load_drop_per_s,releasing,anchor_set,velocity_anchored,points,"
-                 "velocity_points\n");
+                 "velocity_points,anchor_overlap_points\n");
     sinks.on_frame = [slip](std::size_t, const tt::FrameResult& r, const tt::Replayer& engine) {
       const auto& res = engine.result();
       for (int k = 0; k < 2; ++k) {
         const auto& sr = res.sensors[static_cast<std::size_t>(k)];
         if (!res.present[static_cast<std::size_t>(k)]) continue;
         const auto& m = sr.motion;
-        std::fprintf(slip, "%lld,%s,%d,%d,%d,%d,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,%d\n",
+        std::fprintf(slip, "%lld,%s,%d,%d,%d,%d,%.6g,%.6g,%.6g,%.6g,%d,%d,%d,%d,%d,%d\n",
                      static_cast<long long>(r.t_ns), k == 0 ? "left" : "right", m.contact ? 1 : 0,
                      sr.slipping ? 1 : 0, m.slip_onset ? 1 : 0, m.stick_confirmed ? 1 : 0,
                      m.slip_relax_rate, m.shear_shift_m, m.shear_rate_m_s, m.load_drop_rate,
                      m.releasing ? 1 : 0, m.anchor_set ? 1 : 0, m.velocity_anchored ? 1 : 0,
-                     m.points, m.velocity_points);
+                     m.points, m.velocity_points, m.anchor_overlap_points);
       }
     };
   }

@@ -138,8 +138,10 @@ struct SensorMotion {
   // §4.2d): the shear over Ω is a drag (|t| > |θ|·L in planar_content, kVelocityAnchorDragRatio)
   // and Ω and the anchor share at least kVelocityAnchorMinOverlap of the smaller one's cells.
   bool velocity_anchored = false;
-  // The cells the velocity proxy read: |Ω ∩ anchor| or |Ω| (every mode).
+  // The cells the velocity proxy read: |Ω ∩ anchor| or |Ω| (every mode), and |Ω ∩ anchor|
+  // (0 without an anchor), what the overlap test compares.
   int velocity_points = 0;
+  int anchor_overlap_points = 0;
   // --- the same frame as kVelocity would have read it: the velocity proxy's moments and ω, and
   // the sliding translation rule. Differs from the reading above only while kAuto sticks
   // (velocity_differs); otherwise a copy of it. Its region follows this estimator's anchor,
