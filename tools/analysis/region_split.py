@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+# tacse3 tools: replay readings split by the velocity proxy's anchor overlap (accuracy.md 2 (g)).
+"""Reads a `tacse3-replay --out OUT.csv --slip-log SLIP.csv` pair and the recording's truth.csv
+(standard library only) and splits the frames of a time window by how much of the anchored
+patch the contact mask still holds, the quantity the velocity proxy's overlap test compares
+(dsp::kVelocityAnchorMinOverlap, docs/dsp.md §4.2d):
+
+    overlap = |Ω ∩ anchor| / min(|anchor|, |Ω|)
+
+per pad, |anchor| being `points` in the pad's last earlier row with `anchor_set` = 1 (a row
+without contact drops it, as the pipeline does). A frame takes the
+smaller overlap of the pads in contact and falls in the first bin whose lower edge it reaches
+(--edges, descending; default 0.5 0.3 0), or in "no anchor" (no pad in contact with an anchor).
+Per bin it prints the frame count, how many of those frames every pad in contact read the
+anchored region (`velocity_anchored`), and the rotation about the chosen G axis that the
+replay's twist and the truth each carry over those frames (degrees: the sum of the rate about
+the axis times the frame interval). Replay with --mode velocity, so that every frame's twist is
+the velocity proxy's; the replay's moving average spreads a frame's reading over the next few
+frames, so a bin's sum is accurate to about a window's worth of reading at its edges.
+
+Usage: region_split.py OUT_CSV RECORDING_DIR SLIP_CSV [--axis x|y|z] [--start S] [--end S]
+                       [--edges 0.5 0.3 0]
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from friction_cap_bound import spatial_rate  # noqa: E402
+
+
+def fail(message):
+    sys.exit(f"region_split: {message}")
+
+
+def read_rows(path, needed):
+    try:
+        with open(path, newline="") as f:
+            reader = csv.DictReader(f)
+            missing = [k for k in needed if k not in (reader.fieldnames or [])]
+            if missing:
+                fail(f"{path}: no column {', '.join(missing)}")
+            rows = list(reader)
+    except OSError as e:
+        fail(f"cannot read {path} ({e.strerror})")
+    return rows
+
+
+def number(path, row, key, cast=float):
+    try:
+        value = cast(row[key])
+    except (TypeError, ValueError):
+        fail(f"{path}: {key} = {row[key]!r} is not a number")
+    if cast is float and not math.isfinite(value):
+        fail(f"{path}: {key} = {row[key]!r} is not finite")
+    return value
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("out_csv")
+    parser.add_argument("recording")
+    parser.add_argument("slip_csv")
+    parser.add_argument("--axis", choices=["x", "y", "z"], default="x")
+    parser.add_argument("--start", type=float, default=0.6, help="window start, s (default 0.6)")
+    parser.add_argument("--end", type=float, default=2.6, help="window end, s (default 2.6)")
+    parser.add_argument("--edges", type=float, nargs="+", default=[0.5, 0.3, 0.0])
+    args = parser.parse_args()
+    if not args.end > args.start:
+        fail("--end must be after --start")
+    if any(not 0.0 <= e <= 1.0 for e in args.edges) or args.edges != sorted(args.edges)[::-1]:
+        fail("--edges must be descending fractions in 0 .. 1")
+    if args.edges[-1] != 0.0:
+        args.edges.append(0.0)
+    axis = "xyz".index(args.axis)
+
+    out_path = args.out_csv
+    out = read_rows(out_path, ["t_ns", "wx", "wy", "wz"])
+    estimate = {}
+    for row in out:
+        t = number(out_path, row, "t_ns", int)
+        estimate[t] = number(out_path, row, "w" + args.axis)
+
+    truth_path = args.recording.rstrip("/") + "/truth.csv"
+    truth = []
+    for row in read_rows(truth_path, ["t_ns", "qw", "qx", "qy", "qz"]):
+        q = tuple(number(truth_path, row, k) for k in ("qw", "qx", "qy", "qz"))
+        norm = math.sqrt(sum(x * x for x in q))
+        if abs(norm - 1.0) > 1e-3:
+            fail(f"{truth_path}: quaternion at t_ns {row['t_ns']} is not unit (|q| = {norm:.6f})")
+        truth.append((number(truth_path, row, "t_ns", int), q))
+    for (t0, _), (t1, _) in zip(truth, truth[1:]):
+        if t1 <= t0:
+            fail(f"{truth_path}: t_ns {t1} does not increase")
+
+    slip_path = args.slip_csv
+    columns = ["t_ns", "sensor", "contact", "anchor_set", "velocity_anchored", "points",
+               "anchor_overlap_points"]
+    pads = {}  # t_ns -> list of (overlap fraction or None, velocity_anchored)
+    anchor = {}
+    for row in read_rows(slip_path, columns):
+        t = number(slip_path, row, "t_ns", int)
+        sensor = row["sensor"]
+        points = number(slip_path, row, "points", int)
+        if number(slip_path, row, "contact", int) != 1:
+            anchor.pop(sensor, None)  # a contact's loss drops its anchor
+            continue
+        # The overlap is against the anchor held before this frame: one set this frame applies
+        # from the next (a contact's first frame has none).
+        fraction = None
+        if anchor.get(sensor, 0) > 0 and points > 0:
+            held = number(slip_path, row, "anchor_overlap_points", int)
+            fraction = held / min(anchor[sensor], points)
+        pads.setdefault(t, []).append(
+            (fraction, number(slip_path, row, "velocity_anchored", int) == 1))
+        if number(slip_path, row, "anchor_set", int) == 1:
+            anchor[sensor] = points
+
+    labels = [f"overlap >= {e:g}" for e in args.edges] + ["no anchor"]
+    bins = {label: [0, 0, 0.0, 0.0] for label in labels}  # frames, anchored, estimate, truth
+    start_ns, end_ns = args.start * 1e9, args.end * 1e9
+    frames = 0
+    for (t0, q0), (t1, q1) in zip(truth, truth[1:]):
+        if not start_ns <= t1 < end_ns:
+            continue
+        if t1 not in estimate:
+            fail(f"{out_path}: no row at truth t_ns {t1}")
+        frames += 1
+        dt = (t1 - t0) * 1e-9
+        readings = pads.get(t1, [])
+        fractions = [f for f, _ in readings if f is not None]
+        if not fractions:
+            label = "no anchor"
+        else:
+            smallest = min(fractions)
+            label = next(labels[i] for i, e in enumerate(args.edges) if smallest >= e)
+        entry = bins[label]
+        entry[0] += 1
+        entry[1] += 1 if readings and all(a for _, a in readings) else 0
+        entry[2] += math.degrees(estimate[t1] * dt)
+        entry[3] += math.degrees(spatial_rate(q0, q1, 1.0)[axis])  # the rotation vector
+    if frames == 0:
+        fail(f"no truth frame in {args.start:g} .. {args.end:g} s")
+
+    print(f"{frames} frames in {args.start:g} .. {args.end:g} s; rotation about G {args.axis}, "
+          "degrees")
+    for label in labels:
+        n, anchored, est, tru = bins[label]
+        if n == 0:
+            continue
+        ratio = f"{est / tru:.3f}" if abs(tru) > 1e-9 else "-"
+        print(f"  {label:>15}: {n:4d} frames ({anchored} read the anchored region), "
+              f"estimated {est:8.2f}, truth {tru:8.2f}, ratio {ratio}")
+
+
+if __name__ == "__main__":
+    main()
