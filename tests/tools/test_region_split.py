@@ -11,9 +11,10 @@ overlap exactly at the edge over a mask smaller than its anchor (30 of 60 cells:
 dividing by the anchor would give 0.3), a frame without left contact, and a new left contact
 whose first frame has no anchor (the old one must not count) and sets one of 90 cells.
 Checks every bin's frame count, anchored count and both sums (degrees: rate x frame interval),
-the window, another axis (no truth rotation: ratio "-"), and clear errors (exit 1, message on
-stderr) for a missing column, a non-number, a non-unit quaternion, a truth time that does not
-increase, a replay without a truth frame's row and edges that do not descend.
+the window, the truth through a lag and a moving average (closed form from rest), another axis
+(no truth rotation: ratio "-"), and clear errors (exit 1, message on stderr) for a missing
+column, a non-number, a non-unit quaternion, a truth time that does not increase, a replay
+without a truth frame's row, edges that do not descend and a bad lag or average.
 
 Usage: test_region_split.py SCRIPT
 """
@@ -165,6 +166,25 @@ with tempfile.TemporaryDirectory() as tmp:
           f"default window, 0.3 bin: {r.stdout}")
     check(bins.get("overlap >= 0.5", (0,))[0] == 61, f"default window, 0.5 bin: {r.stdout}")
 
+    # The truth through a 0.05 s lag and a 3-frame average: the lagged rate is
+    # RATE (1 - exp(-k dt / tau)) at frame k (from rest at frame 0), averaged over frames
+    # max(1, k - 2) .. k.
+    tau, n_avg = 0.05, 3
+    lagged = lambda k: RATE * (1.0 - math.exp(-k / FPS / tau))  # noqa: E731
+    r = run(base, "--start", "0", "--end", "2", "--lag-s", str(tau), "--average-frames", str(n_avg))
+    bins = parse(r.stdout)
+    check(r.returncode == 0 and "through a 0.05 s lag and a 3-frame average" in r.stdout,
+          f"lag: {r.returncode} {r.stdout} {r.stderr}")
+    for label, (n, anchored, frames) in want.items():
+        got = bins.get(label)
+        if got is None:
+            failures.append(f"lag: bin {label} missing")
+            continue
+        tru = math.degrees(sum(sum(lagged(j) for j in range(max(1, k - n_avg + 1), k + 1)) /
+                               (k - max(1, k - n_avg + 1) + 1) for k in frames) / FPS)
+        check(abs(got[3] - tru) < 0.011, f"lag: {label}: truth {got[3]}, want {tru:.3f}")
+        check(got[0] == n and got[1] == anchored, f"lag: {label}: counts {got[:2]}")
+
     # About G y there is no truth rotation and no estimate: ratios are "-".
     r = run(base, "--axis", "y", "--start", "0", "--end", "2")
     bins = parse(r.stdout)
@@ -194,6 +214,11 @@ with tempfile.TemporaryDirectory() as tmp:
         out_rows=[header] + [f"{i * 10**9 // FPS},0,0,0" for i in range(60)])
     r = run(base, "--edges", "0.3", "0.5")
     check(r.returncode == 1 and "descending" in r.stderr, f"edges ascending: {r.stderr!r}")
+    for option, value, message in (("--lag-s", "-1", "--lag-s must be"),
+                                   ("--lag-s", "nan", "--lag-s must be"),
+                                   ("--average-frames", "0", "--average-frames must be")):
+        r = run(base, option, value)
+        check(r.returncode == 1 and message in r.stderr, f"{option} {value}: {r.stderr!r}")
 
 if failures:
     print("\n".join(failures))

@@ -16,11 +16,14 @@ Per bin it prints the frame count, how many of those frames every pad in contact
 anchored region (`velocity_anchored`), and the rotation about the chosen G axis that the
 replay's twist and the truth each carry over those frames (degrees: the sum of the rate about
 the axis times the frame interval). Replay with --mode velocity, so that every frame's twist is
-the velocity proxy's; the replay's moving average spreads a frame's reading over the next few
-frames, so a bin's sum is accurate to about a window's worth of reading at its edges.
+the velocity proxy's. A slide's shear follows the speed through the simulator's lag (its
+recording.json "lag_time_s") and the replay averages the last few frames (the calibration's
+moving_average_length), so a bin in the accelerating part of a motion reads low and one in the
+decelerating part high against the truth itself; --lag-s and --average-frames pass the truth's
+rate through the same two filters first, which makes the bins' ratios comparable.
 
 Usage: region_split.py OUT_CSV RECORDING_DIR SLIP_CSV [--axis x|y|z] [--start S] [--end S]
-                       [--edges 0.5 0.3 0]
+                       [--edges 0.5 0.3 0] [--lag-s TAU] [--average-frames N]
 """
 import argparse
 import csv
@@ -68,7 +71,16 @@ def main():
     parser.add_argument("--start", type=float, default=0.6, help="window start, s (default 0.6)")
     parser.add_argument("--end", type=float, default=2.6, help="window end, s (default 2.6)")
     parser.add_argument("--edges", type=float, nargs="+", default=[0.5, 0.3, 0.0])
+    parser.add_argument("--lag-s", type=float, default=0.0,
+                        help="pass the truth's rate through a first-order lag of this time "
+                             "constant (s) first (default 0: none)")
+    parser.add_argument("--average-frames", type=int, default=1,
+                        help="then through a moving average of this many frames (default 1)")
     args = parser.parse_args()
+    if not (math.isfinite(args.lag_s) and 0.0 <= args.lag_s <= 10.0):
+        fail("--lag-s must be in 0 .. 10 s")
+    if not 1 <= args.average_frames <= 1000:
+        fail("--average-frames must be in 1 .. 1000")
     if not args.end > args.start:
         fail("--end must be after --start")
     if any(not 0.0 <= e <= 1.0 for e in args.edges) or args.edges != sorted(args.edges)[::-1]:
@@ -123,13 +135,18 @@ def main():
     bins = {label: [0, 0, 0.0, 0.0] for label in labels}  # frames, anchored, estimate, truth
     start_ns, end_ns = args.start * 1e9, args.end * 1e9
     frames = 0
+    lagged = 0.0  # the truth's rate about the axis through the lag, rad/s
+    recent = []   # and its last average_frames values
     for (t0, q0), (t1, q1) in zip(truth, truth[1:]):
+        dt = (t1 - t0) * 1e-9
+        rate = spatial_rate(q0, q1, dt)[axis]
+        lagged += (1.0 - math.exp(-dt / args.lag_s) if args.lag_s > 0 else 1.0) * (rate - lagged)
+        recent = (recent + [lagged])[-args.average_frames:]
         if not start_ns <= t1 < end_ns:
             continue
         if t1 not in estimate:
             fail(f"{out_path}: no row at truth t_ns {t1}")
         frames += 1
-        dt = (t1 - t0) * 1e-9
         readings = pads.get(t1, [])
         fractions = [f for f, _ in readings if f is not None]
         if not fractions:
@@ -141,12 +158,16 @@ def main():
         entry[0] += 1
         entry[1] += 1 if readings and all(a for _, a in readings) else 0
         entry[2] += math.degrees(estimate[t1] * dt)
-        entry[3] += math.degrees(spatial_rate(q0, q1, 1.0)[axis])  # the rotation vector
+        entry[3] += math.degrees(sum(recent) / len(recent) * dt)
     if frames == 0:
         fail(f"no truth frame in {args.start:g} .. {args.end:g} s")
 
+    filtered = ""
+    if args.lag_s > 0 or args.average_frames > 1:
+        filtered = (f"; the truth through a {args.lag_s:g} s lag and a {args.average_frames}-frame"
+                    " average")
     print(f"{frames} frames in {args.start:g} .. {args.end:g} s; rotation about G {args.axis}, "
-          "degrees")
+          f"degrees{filtered}")
     for label in labels:
         n, anchored, est, tru = bins[label]
         if n == 0:
