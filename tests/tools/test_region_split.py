@@ -18,6 +18,7 @@ without a truth frame's row, edges that do not descend and a bad lag or average.
 
 Usage: test_region_split.py SCRIPT
 """
+import json
 import math
 import os
 import re
@@ -41,23 +42,23 @@ def pads_of(i):
         return (0, 0, 0, 0), (0, 0, 0, 0)
     if i == 12:
         return (1, 1, 100, 0), (1, 1, 80, 0)
-    right = (1, 0, 90, 70) if i < 60 else (1, 0, 90, 30) if i < 120 else \
-        (1, 0, 90, 10) if i < 180 else (1, 0, 80, 79)
-    if i < 60:
-        left = (1, 0, 120, 90)      # 0.9 (right 70/80 = 0.875)
-    elif i < 120:
-        left = (1, 0, 120, 50)      # 0.5 (right 30/80 = 0.375)
-    elif i < 180:
-        left = (1, 0, 120, 20)      # 0.2 (right 0.125)
-    elif i < 210:
-        left = (1, 0, 60, 30)       # 30 / min(100, 60) = 0.5 exactly (right 0.9875)
-    elif i == 210:
-        left = (0, 0, 0, 0)         # contact lost: the anchor goes
-    elif i == 211:
-        left = (1, 1, 90, 0)        # new contact, first frame: no anchor, sets 90
-    else:
-        left = (1, 0, 90, 85)       # 85/90
-    return left, right
+    if i < 60:    # 90/100 = 0.9; 40 / min(80, 90) = 0.5 exactly (40/90 would be 0.44)
+        return (1, 0, 120, 90), (1, 0, 90, 40)
+    if i < 120:   # 50/100 = 0.5; 24/80 = 0.3 exactly
+        return (1, 0, 120, 50), (1, 0, 90, 24)
+    if i < 180:   # 0.2; 0.125
+        return (1, 0, 120, 20), (1, 0, 90, 10)
+    if i < 210:   # 30 / min(100, 60) = 0.5 exactly (30/100 would be 0.3); 79/80
+        return (1, 0, 60, 30), (1, 0, 80, 79)
+    if i == 210:  # left contact lost: its anchor goes
+        return (0, 0, 0, 0), (1, 0, 80, 79)
+    if i == 211:  # a new left contact, first frame: no anchor; sets one of 90 cells
+        return (1, 1, 90, 0), (1, 0, 80, 79)
+    if i < 225:   # 85/90; 79/80
+        return (1, 0, 90, 85), (1, 0, 80, 79)
+    if i == 225:  # the right pad re-anchors mid-contact (59/60 of the old 80), to 60 cells
+        return (1, 0, 90, 85), (1, 1, 60, 59)
+    return (1, 0, 90, 85), (1, 0, 80, 35)  # 35 / min(60, 80) = 0.58 (35/80 would be 0.44)
 
 
 def bin_of(i):
@@ -81,8 +82,12 @@ def velocity_anchored(pad, anchor):
     return int(contact == 1 and anchor > 0 and held >= 0.5 * min(anchor, points))
 
 
-def write(folder, truth_rows=None, out_rows=None, slip_rows=None):
+def write(folder, truth_rows=None, out_rows=None, slip_rows=None, sim=True):
     os.makedirs(os.path.join(folder, "rec"), exist_ok=True)
+    if sim:  # the simulator's block: the motion starts at 0.6 s
+        with open(os.path.join(folder, "rec", "recording.json"), "w") as f:
+            json.dump({"format": "tacse3-recording", "version": 1,
+                       "sim": {"motion_start_ns": 600000000}}, f)
     if truth_rows is None:
         truth_rows = ["t_ns,qw,qx,qy,qz,px,py,pz"]
         for i in range(FRAMES):
@@ -159,7 +164,8 @@ with tempfile.TemporaryDirectory() as tmp:
         check(abs(float(got[4]) - est / tru) < 0.001, f"{label}: ratio {got[4]}, want {est / tru}")
     check(r.stdout.startswith("239 frames in 0 .. 2 s; rotation about G x"), r.stdout)
 
-    # The default window (0.6 .. 2.6 s) holds frames 72 .. 240 here (240 is at 2.0 s).
+    # The default window (the sim block's motion start, 0.6 s, to the recording's end) holds
+    # frames 72 .. 240.
     r = run(base)
     bins = parse(r.stdout)
     check(r.returncode == 0 and bins.get("overlap >= 0.3", (0,))[0] == 48,
@@ -212,13 +218,37 @@ with tempfile.TemporaryDirectory() as tmp:
         truth_rows=["t_ns,qw,qx,qy,qz", "700000000,1,0,0,0", "0,1,0,0,0"])
     bad("no_row", "no row at truth t_ns",
         out_rows=[header] + [f"{i * 10**9 // FPS},0,0,0" for i in range(60)])
-    r = run(base, "--edges", "0.3", "0.5")
-    check(r.returncode == 1 and "descending" in r.stderr, f"edges ascending: {r.stderr!r}")
-    for option, value, message in (("--lag-s", "-1", "--lag-s must be"),
-                                   ("--lag-s", "nan", "--lag-s must be"),
-                                   ("--average-frames", "0", "--average-frames must be")):
-        r = run(base, option, value)
-        check(r.returncode == 1 and message in r.stderr, f"{option} {value}: {r.stderr!r}")
+    slip_header = ("t_ns,sensor,contact,anchor_set,velocity_anchored,points,"
+                   "anchor_overlap_points")
+    bad("held_over_points", "anchor_overlap_points 9 is not in 0 .. points (5)",
+        slip_rows=[slip_header, "0,left,1,1,0,5,9"])
+    bad("sensor", "sensor 'middle' is neither left nor right",
+        slip_rows=[slip_header, "0,middle,1,1,0,5,0"])
+    bad("other_run", "no row at truth t_ns", slip_rows=[slip_header, "1,left,1,1,0,5,0"])
+    bad("same_time", "does not increase",
+        truth_rows=["t_ns,qw,qx,qy,qz", "0,1,0,0,0", "700000000,1,0,0,0", "700000000,1,0,0,0"])
+    folder = os.path.join(tmp, "binary")
+    write(folder)
+    with open(os.path.join(folder, "slip.csv"), "wb") as f:
+        f.write(b"t_ns,sensor\n\xff\xfe,\x80\n")
+    r = run(folder)
+    check(r.returncode == 1 and "not a readable CSV file" in r.stderr, f"binary: {r.stderr!r}")
+    folder = os.path.join(tmp, "no_sim")
+    write(folder, sim=False)
+    r = run(folder)
+    check(r.returncode == 1 and "give --start and --end" in r.stderr, f"no sim: {r.stderr!r}")
+    r = run(folder, "--start", "0", "--end", "2")
+    check(r.returncode == 0, f"no sim, window given: {r.stderr!r}")
+    for option, values, message in (("--edges", ["0.3", "0.5"], "strictly descending"),
+                                    ("--edges", ["0.5", "0.5"], "strictly descending"),
+                                    ("--edges", ["1.5"], "strictly descending"),
+                                    ("--lag-s", ["-1"], "--lag-s must be"),
+                                    ("--lag-s", ["nan"], "--lag-s must be"),
+                                    ("--lag-s", ["11"], "--lag-s must be"),
+                                    ("--average-frames", ["0"], "--average-frames must be"),
+                                    ("--end", ["0.5"], "--end must be after --start")):
+        r = run(base, option, *values)
+        check(r.returncode == 1 and message in r.stderr, f"{option} {values}: {r.stderr!r}")
 
 if failures:
     print("\n".join(failures))

@@ -9,9 +9,11 @@ patch the contact mask still holds, the quantity the velocity proxy's overlap te
     overlap = |Ω ∩ anchor| / min(|anchor|, |Ω|)
 
 per pad, |anchor| being `points` in the pad's last earlier row with `anchor_set` = 1 (a row
-without contact drops it, as the pipeline does). A frame takes the
-smaller overlap of the pads in contact and falls in the first bin whose lower edge it reaches
-(--edges, descending; default 0.5 0.3 0), or in "no anchor" (no pad in contact with an anchor).
+without contact drops it, as the pipeline does; the pipeline also drops it when a frame gap
+restarts a pad that was slipping, which the slip log does not show, so a recording with frame
+gaps can be binned against a stale anchor). A frame takes the smaller overlap of the pads in
+contact and falls in the first bin whose lower edge it reaches (--edges, strictly descending;
+default 0.5 0.3 0), or in "no anchor" (no pad in contact with an anchor).
 Per bin it prints the frame count, how many of those frames every pad in contact read the
 anchored region (`velocity_anchored`), and the rotation about the chosen G axis that the
 replay's twist and the truth each carry over those frames (degrees: the sum of the rate about
@@ -22,11 +24,16 @@ moving_average_length), so a bin in the accelerating part of a motion reads low 
 decelerating part high against the truth itself; --lag-s and --average-frames pass the truth's
 rate through the same two filters first, which makes the bins' ratios comparable.
 
+The window defaults to the simulator's motion start (recording.json "sim" block,
+motion_start_ns) up to the recording's end, so that the lagged reading after the motion counts;
+a recording without that block needs --start and --end.
+
 Usage: region_split.py OUT_CSV RECORDING_DIR SLIP_CSV [--axis x|y|z] [--start S] [--end S]
                        [--edges 0.5 0.3 0] [--lag-s TAU] [--average-frames N]
 """
 import argparse
 import csv
+import json
 import math
 import os
 import sys
@@ -49,7 +56,27 @@ def read_rows(path, needed):
             rows = list(reader)
     except OSError as e:
         fail(f"cannot read {path} ({e.strerror})")
+    except (UnicodeDecodeError, csv.Error) as e:
+        fail(f"{path}: not a readable CSV file ({e})")
     return rows
+
+
+def motion_start_ns(recording):
+    """The sim block's motion_start_ns, or None without a sim block."""
+    path = os.path.join(recording, "recording.json")
+    if not os.path.exists(path):
+        return None
+    try:
+        with open(path) as f:
+            sim = json.load(f).get("sim")
+    except (OSError, UnicodeDecodeError, ValueError, AttributeError) as e:
+        fail(f"cannot read {path} ({e})")
+    if sim is None:
+        return None
+    start = sim.get("motion_start_ns") if isinstance(sim, dict) else None
+    if not isinstance(start, int) or start < 0:
+        fail(f"{path}: sim.motion_start_ns is missing or not a time in ns")
+    return start
 
 
 def number(path, row, key, cast=float):
@@ -68,8 +95,9 @@ def main():
     parser.add_argument("recording")
     parser.add_argument("slip_csv")
     parser.add_argument("--axis", choices=["x", "y", "z"], default="x")
-    parser.add_argument("--start", type=float, default=0.6, help="window start, s (default 0.6)")
-    parser.add_argument("--end", type=float, default=2.6, help="window end, s (default 2.6)")
+    parser.add_argument("--start", type=float,
+                        help="window start, s (default: the simulator's motion start)")
+    parser.add_argument("--end", type=float, help="window end, s (default: the recording's end)")
     parser.add_argument("--edges", type=float, nargs="+", default=[0.5, 0.3, 0.0])
     parser.add_argument("--lag-s", type=float, default=0.0,
                         help="pass the truth's rate through a first-order lag of this time "
@@ -81,10 +109,9 @@ def main():
         fail("--lag-s must be in 0 .. 10 s")
     if not 1 <= args.average_frames <= 1000:
         fail("--average-frames must be in 1 .. 1000")
-    if not args.end > args.start:
-        fail("--end must be after --start")
-    if any(not 0.0 <= e <= 1.0 for e in args.edges) or args.edges != sorted(args.edges)[::-1]:
-        fail("--edges must be descending fractions in 0 .. 1")
+    if any(not 0.0 <= e <= 1.0 for e in args.edges) or \
+            any(b >= a for a, b in zip(args.edges, args.edges[1:])):
+        fail("--edges must be strictly descending fractions in 0 .. 1")
     if args.edges[-1] != 0.0:
         args.edges.append(0.0)
     axis = "xyz".index(args.axis)
@@ -107,16 +134,40 @@ def main():
     for (t0, _), (t1, _) in zip(truth, truth[1:]):
         if t1 <= t0:
             fail(f"{truth_path}: t_ns {t1} does not increase")
+    if len(truth) < 2:
+        fail(f"{truth_path}: fewer than two rows")
+    # The window in ns, [start, end): times given in seconds round to the nanosecond.
+    for name in ("start", "end"):
+        value = getattr(args, name)
+        if value is not None and not (math.isfinite(value) and abs(value) < 1e6):
+            fail(f"--{name} must be a time in seconds")
+    if args.start is not None:
+        start_ns = round(args.start * 1e9)
+    else:
+        start_ns = motion_start_ns(args.recording)
+        if start_ns is None:
+            fail(f"{args.recording} has no simulator block: give --start and --end")
+    end_ns = round(args.end * 1e9) if args.end is not None else truth[-1][0] + 1
+    if not end_ns > start_ns:
+        fail("--end must be after --start")
 
     slip_path = args.slip_csv
     columns = ["t_ns", "sensor", "contact", "anchor_set", "velocity_anchored", "points",
                "anchor_overlap_points"]
     pads = {}  # t_ns -> list of (overlap fraction or None, velocity_anchored)
     anchor = {}
+    seen = set()  # t_ns with a row
     for row in read_rows(slip_path, columns):
         t = number(slip_path, row, "t_ns", int)
         sensor = row["sensor"]
+        if sensor not in ("left", "right"):
+            fail(f"{slip_path}: t_ns {t}: sensor {sensor!r} is neither left nor right")
         points = number(slip_path, row, "points", int)
+        held = number(slip_path, row, "anchor_overlap_points", int)
+        if not 0 <= held <= points:
+            fail(f"{slip_path}: t_ns {t} {sensor}: anchor_overlap_points {held} is not in "
+                 f"0 .. points ({points})")
+        seen.add(t)
         if number(slip_path, row, "contact", int) != 1:
             anchor.pop(sensor, None)  # a contact's loss drops its anchor
             continue
@@ -124,7 +175,6 @@ def main():
         # from the next (a contact's first frame has none).
         fraction = None
         if anchor.get(sensor, 0) > 0 and points > 0:
-            held = number(slip_path, row, "anchor_overlap_points", int)
             fraction = held / min(anchor[sensor], points)
         pads.setdefault(t, []).append(
             (fraction, number(slip_path, row, "velocity_anchored", int) == 1))
@@ -133,7 +183,6 @@ def main():
 
     labels = [f"overlap >= {e:g}" for e in args.edges] + ["no anchor"]
     bins = {label: [0, 0, 0.0, 0.0] for label in labels}  # frames, anchored, estimate, truth
-    start_ns, end_ns = args.start * 1e9, args.end * 1e9
     frames = 0
     lagged = 0.0  # the truth's rate about the axis through the lag, rad/s
     recent = []   # and its last average_frames values
@@ -146,6 +195,8 @@ def main():
             continue
         if t1 not in estimate:
             fail(f"{out_path}: no row at truth t_ns {t1}")
+        if t1 not in seen:
+            fail(f"{slip_path}: no row at truth t_ns {t1} (a slip log of another run?)")
         frames += 1
         readings = pads.get(t1, [])
         fractions = [f for f, _ in readings if f is not None]
@@ -159,15 +210,15 @@ def main():
         entry[1] += 1 if readings and all(a for _, a in readings) else 0
         entry[2] += math.degrees(estimate[t1] * dt)
         entry[3] += math.degrees(sum(recent) / len(recent) * dt)
+    window = f"{start_ns * 1e-9:g} .. {(end_ns - 1) * 1e-9:g} s"
     if frames == 0:
-        fail(f"no truth frame in {args.start:g} .. {args.end:g} s")
+        fail(f"no truth frame in {window}")
 
     filtered = ""
     if args.lag_s > 0 or args.average_frames > 1:
         filtered = (f"; the truth through a {args.lag_s:g} s lag and a {args.average_frames}-frame"
                     " average")
-    print(f"{frames} frames in {args.start:g} .. {args.end:g} s; rotation about G {args.axis}, "
-          f"degrees{filtered}")
+    print(f"{frames} frames in {window}; rotation about G {args.axis}, degrees{filtered}")
     for label in labels:
         n, anchored, est, tru = bins[label]
         if n == 0:

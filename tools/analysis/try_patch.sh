@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# tacse3 tools: build a pipeline variant kept as a patch and run the accuracy benchmark with it.
+# tacse3 tools: build a pipeline variant kept as a patch (benchmark and replay) and benchmark it.
 #
 # Usage: tools/analysis/try_patch.sh PATCH WORK_DIR [tacse3-bench-accuracy options...]
+# (no options: build only)
 # Checks out HEAD into WORK_DIR/src (a detached git worktree of this repository), applies PATCH
 # there, builds tacse3-bench-accuracy and tacse3-replay with the host preset (log:
 # WORK_DIR/build.log) and runs the benchmark with the given options, for example
@@ -16,7 +17,8 @@
 # (docs/accuracy.md item 2 (f) and (g) say which and why); each patch's header says whether it
 # changes the double reference too (if not, the benchmark's fixed−ref columns do not apply to it).
 set -euo pipefail
-[ $# -ge 2 ] || { echo "usage: $0 PATCH WORK_DIR [tacse3-bench-accuracy options...]" >&2; exit 2; }
+usage="usage: $0 PATCH WORK_DIR [tacse3-bench-accuracy options...] (none: build only)"
+[ $# -ge 2 ] || { echo "$usage" >&2; exit 2; }
 
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 [ -f "$1" ] || { echo "$0: $1: no such patch" >&2; exit 1; }
