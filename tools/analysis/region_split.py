@@ -32,6 +32,7 @@ Usage: region_split.py OUT_CSV RECORDING_DIR SLIP_CSV [--axis x|y|z] [--start S]
                        [--edges 0.5 0.3 0] [--lag-s TAU] [--average-frames N]
 """
 import argparse
+import collections
 import csv
 import json
 import math
@@ -185,12 +186,12 @@ def main():
     bins = {label: [0, 0, 0.0, 0.0] for label in labels}  # frames, anchored, estimate, truth
     frames = 0
     lagged = 0.0  # the truth's rate about the axis through the lag, rad/s
-    recent = []   # and its last average_frames values
+    recent = collections.deque(maxlen=args.average_frames)  # and its last values
     for (t0, q0), (t1, q1) in zip(truth, truth[1:]):
         dt = (t1 - t0) * 1e-9
         rate = spatial_rate(q0, q1, dt)[axis]
         lagged += (1.0 - math.exp(-dt / args.lag_s) if args.lag_s > 0 else 1.0) * (rate - lagged)
-        recent = (recent + [lagged])[-args.average_frames:]
+        recent.append(lagged)
         if not start_ns <= t1 < end_ns:
             continue
         if t1 not in estimate:

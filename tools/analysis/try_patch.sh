@@ -9,7 +9,7 @@
 # WORK_DIR/build.log) and runs the benchmark with the given options, for example
 #   -j 2 --friction 1.5 --calibration-out WORK_DIR/cal.toml --markdown WORK_DIR/tables.md
 # The variant's replay stays at WORK_DIR/src/build/host/tools/replay/tacse3-replay, for runs on
-# single recordings (--slip-log, --dump-fields). With no options after WORK_DIR nothing runs.
+# single recordings (--slip-log, --dump-fields).
 # The main checkout's files and build folder are not touched (git records the worktree under
 # .git/worktrees). The worktree stays for inspection, also when a step fails; remove it with
 #   git worktree remove --force WORK_DIR/src
