@@ -166,8 +166,8 @@ macro(tacse3_hal_find_pkg)
 endmacro()
 
 # toml++ (Debian's libtomlplusplus-dev, header-only, used without exceptions) as the INTERFACE
-# target tacse3_dep_tomlpp, defined once for the calibration reader (hal/config), the daemon's
-# board files (firmware) and the tools. Cross builds take the host's headers through a folder
+# target tacse3_dep_tomlpp, defined once for the calibration and board readers (config/) and the
+# tools. Cross builds take the host's headers through a folder
 # holding only a link to them, so the rest of /usr/include stays out of the target's include path.
 # No toml++: no target, and the callers skip what needs it.
 function(tacse3_find_tomlpp)

@@ -8,7 +8,7 @@
 #include <string>
 #include <system_error>
 
-#include "tacse3/firmware/board.hpp"
+#include "tacse3/config/board_file.hpp"
 #include "tacse3/firmware/cli.hpp"
 #include "tacse3/firmware/daemon.hpp"
 
@@ -37,18 +37,18 @@ int main(int argc, char** argv) {
   }
 
   const std::filesystem::path board_file =
-      firmware::resolve_board(opt.board, exe_dir(), TACSE3_SOURCE_BOARDS_DIR, &error);
+      config::resolve_board(opt.board, exe_dir(), TACSE3_SOURCE_BOARDS_DIR, &error);
   if (board_file.empty()) {
     std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
     return 1;
   }
-  firmware::BoardConfig board;
-  if (!firmware::load_board(board_file, &board, &error)) {
+  config::BoardConfig board;
+  if (!config::load_board(board_file, &board, &error)) {
     std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
     return 1;
   }
   if (!opt.can_log.empty()) {
-    board.can.backend = firmware::CanBackend::kLog;
+    board.can.backend = config::CanBackend::kLog;
     board.can.log = opt.can_log;
   }
   if (!opt.can_iface.empty()) board.can.interface = opt.can_iface;
@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (opt.check) {
-    std::fputs(firmware::describe(board).c_str(), stdout);
+    std::fputs(config::describe(board).c_str(), stdout);
     std::printf("  calibration: %s\n", cal.file.empty() ? "built-in defaults" : cal.file.c_str());
     std::printf("ok\n");
     return 0;
@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
   if (opt.verbosity > 0) {
     std::fprintf(stderr, "tacse3d: board %s (%s), calibration %s, CAN %s\n", board.name.c_str(),
                  board_file.c_str(), cal.file.empty() ? "built-in" : cal.file.c_str(),
-                 board.can.backend == firmware::CanBackend::kLog
+                 board.can.backend == config::CanBackend::kLog
                      ? ("log " + board.can.log).c_str()
                      : ("socketcan " + board.can.interface).c_str());
   }

@@ -35,7 +35,7 @@ DEBS="$PWD/build/sysroot/.debs-$DIR_NAME"
 
 # Top-level packages; their runtime dependencies are added below.
 TOP=(libgpiod-dev libgpiod2 libturbojpeg0-dev libturbojpeg0)  # libgpiod2 ships libgpiodcxx.so.1
-# Recording format (hal/recording, the replay/calibrate tools, tacse3d --record).
+# Recording format (recording/, the replay/calibrate tools, tacse3d --record).
 TOP+=(libspng-dev libspng0)
 # The daemon's sd_notify (READY=1, WATCHDOG=1).
 TOP+=(libsystemd-dev libsystemd0)

@@ -33,13 +33,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: tacse3_bench_latency [RUNS=5] [SECONDS=3]\n");
     return 2;
   }
-  BoardConfig board;
+  config::BoardConfig board;
   std::string e;
-  if (!load_board(std::filesystem::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml", &board, &e)) {
+  if (!config::load_board(std::filesystem::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml", &board, &e)) {
     std::fprintf(stderr, "tacse3_bench_latency: %s\n", e.c_str());
     return 1;
   }
-  board.can.backend = CanBackend::kLog;
+  board.can.backend = config::CanBackend::kLog;
   board.can.log = "/dev/null";
   CalibrationSource cal;
   if (!load_calibration_source(TACSE3_SIM_CALIBRATION, &cal, &e)) {

@@ -80,12 +80,12 @@ bool load_calibration_source(const std::string& file, CalibrationSource* out, st
   return true;
 }
 
-bool make_pipeline_config(const BoardConfig& board, const CalibrationSource& cal,
+bool make_pipeline_config(const config::BoardConfig& board, const CalibrationSource& cal,
                           dsp::DualConfig* dual, std::array<dsp::Calibration, 2>* sensors,
                           std::string* error) {
   dsp::DualConfig d;
   d.finger_separation_m = board.pipeline.finger_separation_m;
-  d.fusion = fusion_config(board);
+  d.fusion = config::fusion_config(board);
   const int fps = board.sensors[0].enabled ? board.sensors[0].fps : board.sensors[1].fps;
   d.nominal_frame_period_s = 1.0 / fps;
   std::array<dsp::Calibration, 2> c = cal.set.for_method(board.pipeline.method);
@@ -119,7 +119,7 @@ void Daemon::say(int level, const char* fmt, ...) {
   std::fflush(log_);
 }
 
-std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& options,
+std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const Options& options,
                                        const CalibrationSource& calibration, std::FILE* log,
                                        std::string* error) {
   std::unique_ptr<Daemon> d(new Daemon());
@@ -139,7 +139,7 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
   }
 
   // Cameras.
-  if (board.uses_backend(CameraBackend::kSim)) {
+  if (board.uses_backend(config::CameraBackend::kSim)) {
     hal::SimRigConfig rc;
     rc.scene.object = board.sim.object;
     rc.scene.motion = board.sim.motion;
@@ -161,7 +161,7 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
     }
   }
   for (std::size_t s = 0; s < 2; ++s) {
-    const SensorBoardConfig& sc = board.sensors[s];
+    const config::SensorBoardConfig& sc = board.sensors[s];
     if (!sc.enabled) continue;
     const char* side = s == 0 ? "left" : "right";
     hal::CameraConfig cc;
@@ -172,7 +172,7 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
     cc.buffer_count = sc.buffer_count;
     cc.allow_mjpeg = sc.allow_mjpeg;
     switch (sc.backend) {
-      case CameraBackend::kSim: {
+      case config::CameraBackend::kSim: {
         hal::SimCameraConfig scc;
         scc.sensor = s == 0 ? sim::Sensor::kLeft : sim::Sensor::kRight;
         // Grey: what the sim calibration was fitted on, and the cheapest luma stage.
@@ -183,10 +183,10 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
         d->cameras_[s] = std::move(cam);
         break;
       }
-      case CameraBackend::kV4l2:
+      case config::CameraBackend::kV4l2:
         d->cameras_[s] = hal::make_v4l2_camera(cc);
         break;
-      case CameraBackend::kLibcamera:
+      case config::CameraBackend::kLibcamera:
 #if TACSE3_HAVE_LIBCAMERA
         d->cameras_[s] = hal::make_libcamera_camera(cc);
         break;
@@ -195,7 +195,7 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
                  ".backend \"libcamera\": this tacse3d was built without libcamera";
         return nullptr;
 #endif
-      case CameraBackend::kReplay: {
+      case config::CameraBackend::kReplay: {
 #if TACSE3_HAVE_REPLAY
         // A recording's own pad: the board's left sensor replays the recording's left pad. The
         // [sim] table's realtime/repeat also pace and loop replayed sensors (docs/firmware.md).
@@ -215,8 +215,8 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
 #endif
       }
     }
-    d->backpressure_[s] = !board.sim.realtime && (sc.backend == CameraBackend::kSim ||
-                                                  sc.backend == CameraBackend::kReplay);
+    d->backpressure_[s] = !board.sim.realtime && (sc.backend == config::CameraBackend::kSim ||
+                                                  sc.backend == config::CameraBackend::kReplay);
     const hal::CameraStatus st = d->cameras_[s]->open();
     if (!st.ok()) {
       *error = std::string("sensor ") + side + " (" + to_string(sc.backend) + " " + sc.device +
@@ -239,7 +239,7 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
   ep.node_id = static_cast<std::uint8_t>(board.can.node_id);
   ep.layout.mode =
       board.can.extended_ids ? protocol::IdMode::kExtended : protocol::IdMode::kStandard;
-  if (!options.can_log.empty() || board.can.backend == CanBackend::kLog) {
+  if (!options.can_log.empty() || board.can.backend == config::CanBackend::kLog) {
     const std::string out = !options.can_log.empty() ? options.can_log : board.can.log;
     std::string e;
     auto ch = hal::can::LogChannel::open(
@@ -265,7 +265,7 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
   }
 
   // GPIO.
-  d->gpio_ = board.gpio.backend == GpioBackendKind::kLibgpiod ? hal::make_libgpiod_gpio()
+  d->gpio_ = board.gpio.backend == config::GpioBackendKind::kLibgpiod ? hal::make_libgpiod_gpio()
                                                               : hal::make_null_gpio();
   hal::GpioConfig gc = board.gpio.lines;
   gc.consumer = "tacse3d";
@@ -302,7 +302,7 @@ std::unique_ptr<Daemon> Daemon::create(const BoardConfig& board, const Options& 
   if (!options.record_dir.empty()) {
 #if TACSE3_HAVE_RECORDER
     RecorderConfig rc;
-    const SensorBoardConfig& s0 = board.sensors[0].enabled ? board.sensors[0] : board.sensors[1];
+    const config::SensorBoardConfig& s0 = board.sensors[0].enabled ? board.sensors[0] : board.sensors[1];
     rc.width = s0.width;
     rc.height = s0.height;
     rc.fps = s0.fps;

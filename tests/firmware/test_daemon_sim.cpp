@@ -55,10 +55,10 @@ TEST(DaemonSim, UnplugDegradesReplugRecoversNoCycleLost) {
   text.replace(text.find("realtime = true"), 15, "realtime = false");
   text.replace(text.find("stale_ms = 50"), 13, "stale_ms = 1000");
   text.replace(text.find("lost_ms = 500"), 13, "lost_ms = 2000");
-  BoardConfig board;
+  config::BoardConfig board;
   std::string e;
-  ASSERT_TRUE(parse_board(text, "sim-test", &board, &e)) << e;
-  board.can.backend = CanBackend::kLog;
+  ASSERT_TRUE(config::parse_board(text, "sim-test", &board, &e)) << e;
+  board.can.backend = config::CanBackend::kLog;
   board.can.log = log.string();
   Options opt;
   opt.verbosity = 0;

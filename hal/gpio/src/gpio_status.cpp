@@ -33,20 +33,6 @@ const char* to_string(GpioError e) noexcept {
   return "unknown GPIO error";
 }
 
-const char* to_string(GpioLine line) noexcept {
-  switch (line) {
-    case GpioLine::kStatusLed:
-      return "status_led";
-    case GpioLine::kTareButton:
-      return "tare_button";
-    case GpioLine::kSensorTrigger:
-      return "sensor_trigger";
-    case GpioLine::kGripperClosed:
-      return "gripper_closed";
-  }
-  return "unknown_line";
-}
-
 GpioStatus GpioStatus::error(GpioError code, const char* fmt, ...) noexcept {
   GpioStatus s;
   s.code = code;

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "tacse3/config/calibration_file.hpp"
-#include "tacse3/firmware/board.hpp"
+#include "tacse3/config/board_file.hpp"
 #include "tacse3/firmware/cli.hpp"
 #include "tacse3/firmware/engine.hpp"
 #include "tacse3/hal/can/channel.hpp"
@@ -36,7 +36,7 @@ struct CalibrationSource {
 bool load_calibration_source(const std::string& file, CalibrationSource* out, std::string* error);
 
 // The pipeline configuration of a board + calibration (what --check validates).
-bool make_pipeline_config(const BoardConfig& board, const CalibrationSource& cal,
+bool make_pipeline_config(const config::BoardConfig& board, const CalibrationSource& cal,
                           dsp::DualConfig* dual, std::array<dsp::Calibration, 2>* sensors,
                           std::string* error);
 
@@ -56,7 +56,7 @@ struct DaemonSummary {
 class Daemon {
  public:
   // Opens every device of the board (cameras, CAN channel, GPIO). Diagnostics go to `log`.
-  static std::unique_ptr<Daemon> create(const BoardConfig& board, const Options& options,
+  static std::unique_ptr<Daemon> create(const config::BoardConfig& board, const Options& options,
                                         const CalibrationSource& calibration, std::FILE* log,
                                         std::string* error);
   ~Daemon();
@@ -88,7 +88,7 @@ class Daemon {
   void finish_summary();
   void say(int level, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
 
-  BoardConfig board_;
+  config::BoardConfig board_;
   Options options_;
   CalibrationSource calibration_;
   std::FILE* log_ = stderr;

@@ -15,7 +15,7 @@ namespace tacse3::hal::can {
 // errno), so a fake can script failures without touching the thread's errno and the channel
 // never reads errno after an intervening call.
 //
-// The real implementation is system_socket_ops(). A fake (tests/hal_can/fake_socket.hpp) plays
+// The real implementation is system_socket_ops(). A fake (tests/hal/can/fake_socket.hpp) plays
 // the kernel: it returns ENOBUFS, EAGAIN, ENETDOWN, ENXIO, delivers error frames and records
 // the socket options it was given. That is how the TX queue, error-frame and recovery policies
 // are unit-tested on hosts without AF_CAN and beyond what vcan can simulate (vcan produces no

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 protocol: the hal/can log channel round trip and the SocketCAN failure message.
+// tacse3 hal/can: the log channel round trip and the SocketCAN failure message.
 #include <gtest/gtest.h>
 
 #include <cstdio>

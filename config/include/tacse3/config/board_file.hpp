@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: the board file (boards/<name>/board.toml, schema version 1): parse, validate.
+// tacse3 config: the board file (boards/<name>/board.toml, schema version 1): parse, validate.
 #pragma once
 
 #include <array>
@@ -8,12 +8,12 @@
 #include <string>
 #include <string_view>
 
+#include "tacse3/config/gpio_lines.hpp"
 #include "tacse3/dsp/fusion.hpp"
-#include "tacse3/hal/gpio.hpp"
 #include "tacse3/protocol/ids.hpp"
 #include "tacse3/protocol/types.hpp"
 
-namespace tacse3::firmware {
+namespace tacse3::config {
 
 inline constexpr int kBoardVersion = 1;
 
@@ -76,7 +76,7 @@ enum class GpioBackendKind : std::uint8_t { kNull = 0, kLibgpiod };
 // [gpio]
 struct GpioBoardConfig {
   GpioBackendKind backend = GpioBackendKind::kNull;
-  hal::GpioConfig lines;  // chip + the optional lines (enabled = table present)
+  GpioConfig lines;  // chip + the optional lines (enabled = table present)
   int debounce_ms = 20;   // [gpio.tare_button].debounce_ms (also used for gripper_closed)
 };
 
@@ -131,4 +131,4 @@ dsp::FusionConfig fusion_config(const BoardConfig& board) noexcept;
 // Multi-line human-readable summary for --check.
 std::string describe(const BoardConfig& board);
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::config

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: board file reader (toml++, no exceptions) with every key validated and named.
-#include "tacse3/firmware/board.hpp"
+// tacse3 config: board file reader (toml++, no exceptions) with every key validated and named.
+#include "tacse3/config/board_file.hpp"
 
-// Header-only toml++ without exceptions, as in hal/config: a bad board file must come back as a
+// Header-only toml++ without exceptions, as in calibration_file.cpp: a bad board file must come back as a
 // message, never as an exception or an assert. Only this translation unit includes toml++.
 #define TOML_HEADER_ONLY 1
 #define TOML_EXCEPTIONS 0
@@ -21,7 +21,7 @@
 
 #include "tacse3/config/toml_names.hpp"
 
-namespace tacse3::firmware {
+namespace tacse3::config {
 
 const char* to_string(CameraBackend b) noexcept {
   switch (b) {
@@ -268,14 +268,14 @@ void read_sensor(Reader& rd, const toml::table& t, const std::string& path, Sens
   }
 }
 
-void read_gpio_line(Reader& rd, const toml::table& parent, const char* key, hal::GpioLine line,
+void read_gpio_line(Reader& rd, const toml::table& parent, const char* key, GpioLine line,
                     GpioBoardConfig* g) {
   const std::string path = std::string("gpio.") + key;
   const toml::table* t = rd.table(parent, key, "gpio");
   if (t == nullptr) return;
-  hal::GpioLineConfig& l = g->lines.line(line);
+  GpioLineConfig& l = g->lines.line(line);
   l.enabled = true;
-  const bool input = !hal::is_output(line);
+  const bool input = !is_output(line);
   if (input) {
     if (!rd.only_keys(*t, path, {"offset", "name", "chip", "active_low", "bias", "debounce_ms"})) {
       return;
@@ -288,11 +288,11 @@ void read_gpio_line(Reader& rd, const toml::table& parent, const char* key, hal:
   rd.string(*t, "chip", path, &l.chip);
   rd.boolean(*t, "active_low", path, &l.active_low);
   if (input) {
-    rd.choice<hal::GpioBias>(*t, "bias", path,
-                             {{"as-is", hal::GpioBias::kAsIs},
-                              {"disable", hal::GpioBias::kDisable},
-                              {"pull-up", hal::GpioBias::kPullUp},
-                              {"pull-down", hal::GpioBias::kPullDown}},
+    rd.choice<GpioBias>(*t, "bias", path,
+                             {{"as-is", GpioBias::kAsIs},
+                              {"disable", GpioBias::kDisable},
+                              {"pull-up", GpioBias::kPullUp},
+                              {"pull-down", GpioBias::kPullDown}},
                              &l.bias);
     rd.integer(*t, "debounce_ms", path, 0, 1000, &g->debounce_ms);
   }
@@ -429,10 +429,10 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
         {{"null", GpioBackendKind::kNull}, {"libgpiod", GpioBackendKind::kLibgpiod}},
         &b.gpio.backend);
     rd.string(*t, "chip", "gpio", &b.gpio.lines.chip);
-    read_gpio_line(rd, *t, "status_led", hal::GpioLine::kStatusLed, &b.gpio);
-    read_gpio_line(rd, *t, "tare_button", hal::GpioLine::kTareButton, &b.gpio);
-    read_gpio_line(rd, *t, "sensor_trigger", hal::GpioLine::kSensorTrigger, &b.gpio);
-    read_gpio_line(rd, *t, "gripper_closed", hal::GpioLine::kGripperClosed, &b.gpio);
+    read_gpio_line(rd, *t, "status_led", GpioLine::kStatusLed, &b.gpio);
+    read_gpio_line(rd, *t, "tare_button", GpioLine::kTareButton, &b.gpio);
+    read_gpio_line(rd, *t, "sensor_trigger", GpioLine::kSensorTrigger, &b.gpio);
+    read_gpio_line(rd, *t, "gripper_closed", GpioLine::kGripperClosed, &b.gpio);
   }
 
   if (const toml::table* t = rd.table(root, "realtime", "")) {
@@ -554,10 +554,10 @@ std::string describe(const BoardConfig& b) {
     << ", tx queue " << b.can.tx_queue << ", rate divider " << b.can.rate_divider << "\n";
   s << "  gpio: "
     << (b.gpio.backend == GpioBackendKind::kNull ? "null" : "libgpiod " + b.gpio.lines.chip);
-  for (std::size_t i = 0; i < hal::kGpioLineCount; ++i) {
+  for (std::size_t i = 0; i < kGpioLineCount; ++i) {
     const auto& l = b.gpio.lines.lines[i];
     if (!l.enabled) continue;
-    s << ", " << hal::to_string(static_cast<hal::GpioLine>(i)) << "="
+    s << ", " << to_string(static_cast<GpioLine>(i)) << "="
       << (l.name.empty() ? std::to_string(l.offset) : l.name)
       << (l.active_low ? " (active low)" : "");
   }
@@ -566,4 +566,4 @@ std::string describe(const BoardConfig& b) {
   return s.str();
 }
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::config

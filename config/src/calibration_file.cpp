@@ -10,7 +10,7 @@
 // toml++ 3.3.0 asserts internal parser invariants that malformed input can break (a flipped byte
 // in a key: parser.inl parse_key). An assert would abort the daemon on a bad file, so the checks
 // are compiled out as in a release build; the parser then reports the malformed input as an error
-// (tests/tools/test_calibration_file.cpp flips every byte under ASan/UBSan).
+// (tests/config/test_calibration_file.cpp flips every byte under ASan/UBSan).
 #define TOML_ASSERT(expr) static_assert(true)
 #include <toml++/toml.h>
 

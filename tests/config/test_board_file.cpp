@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// firmware tests: board files (the shipped ones and bad ones), resolution, calibration loading.
+// config tests: board files (the shipped ones and bad ones) and their resolution by name.
 #include <gtest/gtest.h>
 #include <stdlib.h>
 #include <unistd.h>
@@ -8,12 +8,11 @@
 #include <fstream>
 #include <string>
 
-#include "tacse3/firmware/board.hpp"
-#include "tacse3/firmware/daemon.hpp"
+#include "tacse3/config/board_file.hpp"
 
 namespace fs = std::filesystem;
 using namespace tacse3;
-using namespace tacse3::firmware;
+using namespace tacse3::config;
 
 namespace {
 
@@ -56,15 +55,15 @@ TEST(Board, ShippedBoardsLoad) {
   EXPECT_EQ(uvc.sensors[1].device, "/dev/tacse3-right");
   EXPECT_EQ(uvc.can.bitrate, 500000);
   EXPECT_EQ(uvc.can.mode, protocol::FrameMode::kClassic);
-  EXPECT_EQ(uvc.gpio.lines.line(hal::GpioLine::kTareButton).offset, 27);
-  EXPECT_TRUE(uvc.gpio.lines.line(hal::GpioLine::kTareButton).active_low);
+  EXPECT_EQ(uvc.gpio.lines.line(GpioLine::kTareButton).offset, 27);
+  EXPECT_TRUE(uvc.gpio.lines.line(GpioLine::kTareButton).active_low);
   BoardConfig pi5;
   ASSERT_TRUE(
       load_board(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "rpi5-libcamera/board.toml", &pi5, &e));
   EXPECT_EQ(pi5.can.mode, protocol::FrameMode::kFd);
   EXPECT_EQ(pi5.can.data_bitrate, 2000000);
   EXPECT_EQ(pi5.sensors[0].backend, CameraBackend::kLibcamera);
-  EXPECT_EQ(pi5.gpio.lines.line(hal::GpioLine::kStatusLed).name, "GPIO17");
+  EXPECT_EQ(pi5.gpio.lines.line(GpioLine::kStatusLed).name, "GPIO17");
 }
 
 TEST(Board, MissingTablesTakeTheDocumentedDefaults) {
@@ -193,31 +192,5 @@ TEST(Board, ResolvesNamesInTheDocumentedOrder) {
   EXPECT_NE(e.find("/etc/tacse3/boards/nope/board.toml"), std::string::npos) << e;
   EXPECT_TRUE(resolve_board("./missing.toml", "", "", &e).empty());
   unsetenv("TACSE3_BOARD_DIR");
-  fs::remove_all(dir);
-}
-
-TEST(Calibration, BadFilesAreRejectedWithFileAndKey) {
-  const fs::path dir = scratch_dir();
-  const fs::path bad = dir / "bad.toml";
-  std::ofstream(bad)
-      << "format = \"tacse3-calibration\"\nversion = 1\n[sensor]\ncontact_tau_on = -1.0\n";
-  CalibrationSource c;
-  std::string e;
-  EXPECT_FALSE(load_calibration_source(bad.string(), &c, &e));
-  EXPECT_NE(e.find(bad.string()), std::string::npos) << e;
-  EXPECT_NE(e.find("sensor.contact_tau_on"), std::string::npos) << e;
-  EXPECT_FALSE(load_calibration_source((dir / "absent.toml").string(), &c, &e));
-  EXPECT_NE(e.find("absent.toml"), std::string::npos) << e;
-  // The fitted simulator calibration loads and makes a valid pipeline configuration.
-  ASSERT_TRUE(load_calibration_source(TACSE3_SIM_CALIBRATION, &c, &e)) << e;
-  BoardConfig b;
-  ASSERT_TRUE(load_board(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml", &b, &e)) << e;
-  dsp::DualConfig dual;
-  std::array<dsp::Calibration, 2> cal;
-  ASSERT_TRUE(make_pipeline_config(b, c, &dual, &cal, &e)) << e;
-  EXPECT_DOUBLE_EQ(dual.finger_separation_m, 0.040);
-  EXPECT_DOUBLE_EQ(cal[0].pixel_pitch_m, 1e-4);
-  // velocity_proxy = "auto" keeps the file's proxy (velocity) until dsp has its own auto mode.
-  EXPECT_EQ(dual.fusion.extrinsics[1].R_GS(1, 1), -1.0);
   fs::remove_all(dir);
 }
