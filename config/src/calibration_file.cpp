@@ -23,90 +23,17 @@
 #include <system_error>
 
 #include "tacse3/config/toml_names.hpp"
+#include "tacse3/dsp/calibration_fields.hpp"
 
 namespace tacse3::config {
 namespace {
 
 using dsp::Calibration;
 
-// One key of a sensor table: its member in dsp::Calibration and its documented range
-// (dsp/include/tacse3/dsp/calibration.hpp). lo_open / hi_open: the bound itself is excluded.
-struct Field {
-  enum Kind { kReal, kInt, kVec3, kProxy };
-  const char* key;
-  Kind kind;
-  double lo, hi;
-  bool lo_open, hi_open;
-  double Calibration::*real = nullptr;
-  int Calibration::*integer = nullptr;
-  std::array<double, 3> Calibration::*vec = nullptr;
-};
-
-constexpr double kInf = 1e300;
-
-const std::vector<Field>& fields() {
-  // The order is the file order. When dsp::Calibration gains a field (e.g. the slip detector
-  // thresholds of VelocityProxy::kAuto), one line here makes it readable and writable.
-  static const std::vector<Field> f = {
-      {"pixel_pitch_m", Field::kReal, 1e-6, 2e-4, false, false, &Calibration::pixel_pitch_m},
-      {"pixel_aspect_y", Field::kReal, 0.25, 4.0, false, false, &Calibration::pixel_aspect_y},
-      {"normal_gain_density", Field::kReal, 0.0, 1e4, false, false,
-       &Calibration::normal_gain_density},
-      {"normal_gain_divergence", Field::kReal, 0.0, 1e4, false, false,
-       &Calibration::normal_gain_divergence},
-      {"shear_gain_d", Field::kReal, 0.0, 1e4, false, false, &Calibration::shear_gain_d},
-      {"shear_gain_r", Field::kReal, 0.0, 1e4, false, false, &Calibration::shear_gain_r},
-      {"shear_gain_k", Field::kReal, 0.0, 1e4, false, false, &Calibration::shear_gain_k},
-      {"contact_tau_on", Field::kReal, 0.0, 1e4, true, false, &Calibration::contact_tau_on},
-      {"contact_tau_off", Field::kReal, 0.0, 1e4, false, false, &Calibration::contact_tau_off},
-      {"contact_min_area_cells", Field::kInt, 1, 1200, false, false, nullptr,
-       &Calibration::contact_min_area_cells},
-      {"height_gain_m", Field::kReal, 0.0, 1.0, false, false, &Calibration::height_gain_m},
-      {"height_max_m", Field::kReal, 0.0, 0.01, false, false, &Calibration::height_max_m},
-      {"velocity_proxy", Field::kProxy, 0, 0, false, false},
-      {"c_velocity", Field::kReal, 0.0, 100.0, true, false, &Calibration::c_velocity},
-      {"c_displacement", Field::kReal, 0.0, 1.0, true, false, &Calibration::c_displacement},
-      {"slip_relax_rate_on", Field::kReal, 0.0, 1e3, true, false, &Calibration::slip_relax_rate_on},
-      {"slip_on_frames", Field::kInt, 1, 1000, false, false, nullptr, &Calibration::slip_on_frames},
-      {"slip_min_shift_m", Field::kReal, 0.0, 0.01, false, false, &Calibration::slip_min_shift_m},
-      {"slip_exit_fraction", Field::kReal, 0.0, 1.0, false, false,
-       &Calibration::slip_exit_fraction},
-      {"stick_rest_speed_m_s", Field::kReal, 0.0, 1.0, true, false,
-       &Calibration::stick_rest_speed_m_s},
-      {"stick_confirm_s", Field::kReal, 0.0, 10.0, false, false, &Calibration::stick_confirm_s},
-      {"slip_catchup_frames", Field::kInt, 1, 1000, false, false, nullptr,
-       &Calibration::slip_catchup_frames},
-      {"slip_smoothing_s", Field::kReal, 0.0, 1.0, false, false, &Calibration::slip_smoothing_s},
-      {"release_load_rate", Field::kReal, 0.0, 1e4, true, false, &Calibration::release_load_rate},
-      {"max_mask_change", Field::kReal, 0.0, 1.0, false, false, &Calibration::max_mask_change},
-      {"max_mask_area_ratio", Field::kReal, 1.0, 1e4, false, false,
-       &Calibration::max_mask_area_ratio},
-      {"rotation_scale", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
-       &Calibration::rotation_scale},
-      {"translation_scale", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
-       &Calibration::translation_scale},
-      {"displacement_rotation_ratio", Field::kVec3, 0.0, 100.0, false, false, nullptr, nullptr,
-       &Calibration::displacement_rotation_ratio},
-      {"moving_average_length", Field::kInt, 1, dsp::kMaxMovingAverage, false, false, nullptr,
-       &Calibration::moving_average_length},
-      {"solve_lambda_rel", Field::kReal, 0.0, 1.0, false, false, &Calibration::solve_lambda_rel},
-      {"solve_lever_floor_m", Field::kReal, 0.0, 1e-2, false, false,
-       &Calibration::solve_lever_floor_m},
-      {"solve_rcond_min", Field::kReal, 0.0, 1.0, false, true, &Calibration::solve_rcond_min},
-  };
-  return f;
-}
-
-// Names of the proxy modes as written in the file. VelocityProxy::kAuto gets its line here.
-struct ProxyName {
-  dsp::VelocityProxy value;
-  const char* name;
-};
-constexpr ProxyName kProxyNames[] = {
-    {dsp::VelocityProxy::kVelocity, "velocity"},
-    {dsp::VelocityProxy::kDisplacement, "displacement"},
-    {dsp::VelocityProxy::kAuto, "auto"},
-};
+// The schema (keys, members, ranges, rules) is dsp's: dsp/include/tacse3/dsp/calibration_fields.hpp.
+using Field = dsp::CalibrationField;
+using Kind = dsp::CalibrationField::Kind;
+constexpr const auto& kFields = dsp::kCalibrationFields;
 
 std::string fmt_real(double v) {
   char buf[64];
@@ -122,20 +49,13 @@ std::string fmt_real(double v) {
 
 std::string range_text(const Field& f) {
   std::string s = f.lo_open ? "(" : "[";
-  s += fmt_real(f.lo) + ", " + (f.hi >= kInf ? std::string("inf") : fmt_real(f.hi));
+  s += fmt_real(f.lo) + ", " + fmt_real(f.hi);
   s += f.hi_open ? ")" : "]";
-  if (f.kind == Field::kInt) {
+  if (f.kind == Kind::kInt) {
     s = "[" + std::to_string(static_cast<long long>(f.lo)) + ", " +
         std::to_string(static_cast<long long>(f.hi)) + "]";
   }
   return s;
-}
-
-bool in_range(const Field& f, double v) {
-  if (!std::isfinite(v)) return false;
-  if (f.lo_open ? !(v > f.lo) : !(v >= f.lo)) return false;
-  if (f.hi_open ? !(v < f.hi) : !(v <= f.hi)) return false;
-  return true;
 }
 
 std::string quote(std::string_view s) {
@@ -197,16 +117,16 @@ Status apply_field(const Field& f, const toml::node& n, const std::string& path,
                    const std::string& origin, Calibration* cal) {
   const std::string at = where(origin, n) + "key \"" + path + "\" ";
   switch (f.kind) {
-    case Field::kReal: {
+    case Kind::kReal: {
       double v = 0.0;
       if (!get_real(n, &v)) return Status::error(at + "must be a number, got " + type_name(n));
-      if (!in_range(f, v)) {
+      if (!dsp::field_in_range(f, v)) {
         return Status::error(at + "must be in " + range_text(f) + ", got " + describe(v));
       }
       cal->*(f.real) = v;
       return {};
     }
-    case Field::kInt: {
+    case Kind::kInt: {
       const auto* i = n.as_integer();
       if (i == nullptr) return Status::error(at + "must be an integer, got " + type_name(n));
       const auto v = i->get();
@@ -217,7 +137,7 @@ Status apply_field(const Field& f, const toml::node& n, const std::string& path,
       cal->*(f.integer) = static_cast<int>(v);
       return {};
     }
-    case Field::kVec3: {
+    case Kind::kVec3: {
       const auto* a = n.as_array();
       if (a == nullptr) {
         return Status::error(at + "must be an array of 3 numbers, got " + type_name(n));
@@ -233,7 +153,7 @@ Status apply_field(const Field& f, const toml::node& n, const std::string& path,
           return Status::error(at + "element " + std::to_string(k) + " must be a number, got " +
                                (e ? type_name(*e) : std::string("nothing")));
         }
-        if (!in_range(f, v[k])) {
+        if (!dsp::field_in_range(f, v[k])) {
           return Status::error(at + "element " + std::to_string(k) + " must be in " +
                                range_text(f) + ", got " + describe(v[k]));
         }
@@ -241,13 +161,13 @@ Status apply_field(const Field& f, const toml::node& n, const std::string& path,
       cal->*(f.vec) = v;
       return {};
     }
-    case Field::kProxy: {
+    case Kind::kProxy: {
       const auto* s = n.as_string();
       if (s == nullptr) return Status::error(at + "must be a string, got " + type_name(n));
       dsp::VelocityProxy p{};
       if (!parse_proxy_name(s->get(), &p)) {
         std::string names;
-        for (const auto& pn : kProxyNames)
+        for (const auto& pn : dsp::kVelocityProxyNames)
           names += std::string(names.empty() ? "" : ", ") + pn.name;
         return Status::error(at + "must be one of " + names + ", got \"" + s->get() + "\"");
       }
@@ -259,7 +179,7 @@ Status apply_field(const Field& f, const toml::node& n, const std::string& path,
 }
 
 const Field* find_field(std::string_view key) {
-  for (const auto& f : fields()) {
+  for (const auto& f : kFields) {
     if (key == f.key) return &f;
   }
   return nullptr;
@@ -272,7 +192,7 @@ std::string unknown_key_message(const std::string& origin, const toml::node& n,
 
 std::string sensor_key_list() {
   std::string s;
-  for (const auto& f : fields()) s += std::string(s.empty() ? "" : ", ") + f.key;
+  for (const auto& f : kFields) s += std::string(s.empty() ? "" : ", ") + f.key;
   return s;
 }
 
@@ -458,13 +378,13 @@ Status parse_impl(std::string_view text, const std::string& origin, CalibrationS
 
 bool same(const Calibration& a, const Calibration& b, const Field& f) {
   switch (f.kind) {
-    case Field::kReal:
+    case Kind::kReal:
       return a.*(f.real) == b.*(f.real);
-    case Field::kInt:
+    case Kind::kInt:
       return a.*(f.integer) == b.*(f.integer);
-    case Field::kVec3:
+    case Kind::kVec3:
       return a.*(f.vec) == b.*(f.vec);
-    case Field::kProxy:
+    case Kind::kProxy:
       return a.velocity_proxy == b.velocity_proxy;
   }
   return false;
@@ -472,18 +392,24 @@ bool same(const Calibration& a, const Calibration& b, const Field& f) {
 
 std::string value_text(const Calibration& c, const Field& f) {
   switch (f.kind) {
-    case Field::kReal:
+    case Kind::kReal:
       return fmt_real(c.*(f.real));
-    case Field::kInt:
+    case Kind::kInt:
       return std::to_string(c.*(f.integer));
-    case Field::kVec3: {
+    case Kind::kVec3: {
       const auto& v = c.*(f.vec);
       return "[" + fmt_real(v[0]) + ", " + fmt_real(v[1]) + ", " + fmt_real(v[2]) + "]";
     }
-    case Field::kProxy:
+    case Kind::kProxy:
       return quote(proxy_name(c.velocity_proxy));
   }
   return "";
+}
+
+// A rule's operand (rules name real fields: tests/dsp/test_calibration_fields.cpp).
+double rule_operand(const Calibration& c, const char* key) {
+  const Field* f = dsp::find_calibration_field(key);
+  return f != nullptr && f->real != nullptr ? c.*(f->real) : std::nan("");
 }
 
 std::string vec_text(const std::array<double, 3>& v) {
@@ -493,14 +419,14 @@ std::string vec_text(const std::array<double, 3>& v) {
 }  // namespace
 
 const char* proxy_name(dsp::VelocityProxy p) noexcept {
-  for (const auto& pn : kProxyNames) {
+  for (const auto& pn : dsp::kVelocityProxyNames) {
     if (pn.value == p) return pn.name;
   }
   return "unknown";
 }
 
 bool parse_proxy_name(std::string_view name, dsp::VelocityProxy* out) noexcept {
-  for (const auto& pn : kProxyNames) {
+  for (const auto& pn : dsp::kVelocityProxyNames) {
     if (name == pn.name) {
       *out = pn.value;
       return true;
@@ -511,7 +437,7 @@ bool parse_proxy_name(std::string_view name, dsp::VelocityProxy* out) noexcept {
 
 std::vector<std::string> sensor_keys() {
   std::vector<std::string> k;
-  for (const auto& f : fields()) k.emplace_back(f.key);
+  for (const auto& f : kFields) k.emplace_back(f.key);
   return k;
 }
 
@@ -531,55 +457,49 @@ Status validate(const CalibrationSet& set, const std::string& origin) noexcept {
     const char* names[2] = {"left", "right"};
     for (std::size_t i = 0; i < 2; ++i) {
       const Calibration& c = set.sensor[i];
-      for (const auto& f : fields()) {
+      for (const auto& f : kFields) {
         const std::string at = origin + ": key \"" + names[i] + "." + f.key + "\" ";
         switch (f.kind) {
-          case Field::kReal:
-            if (!in_range(f, c.*(f.real))) {
+          case Kind::kReal:
+            if (!dsp::field_in_range(f, c.*(f.real))) {
               return Status::error(at + "must be in " + range_text(f) + ", got " +
                                    describe(c.*(f.real)));
             }
             break;
-          case Field::kInt:
-            if (!in_range(f, c.*(f.integer))) {
+          case Kind::kInt:
+            if (!dsp::field_in_range(f, c.*(f.integer))) {
               return Status::error(at + "must be an integer in " + range_text(f) + ", got " +
                                    std::to_string(c.*(f.integer)));
             }
             break;
-          case Field::kVec3:
+          case Kind::kVec3:
             for (double v : c.*(f.vec)) {
-              if (!in_range(f, v)) {
+              if (!dsp::field_in_range(f, v)) {
                 return Status::error(at + "elements must be in " + range_text(f) + ", got " +
                                      describe(v));
               }
             }
             break;
-          case Field::kProxy: {
-            dsp::VelocityProxy p{};
-            if (!parse_proxy_name(proxy_name(c.velocity_proxy), &p)) {
+          case Kind::kProxy:
+            if (!dsp::field_valid(f, c)) {
               return Status::error(at + "has an unknown value " +
                                    std::to_string(static_cast<int>(c.velocity_proxy)));
             }
             break;
-          }
         }
       }
-      if (c.contact_tau_off > c.contact_tau_on) {
-        return Status::error(origin + ": key \"" + names[i] + ".contact_tau_off\" (" +
-                             fmt_real(c.contact_tau_off) + ") must not exceed \"" + names[i] +
-                             ".contact_tau_on\" (" + fmt_real(c.contact_tau_on) + ")");
-      }
-      if (c.release_load_rate < dsp::kReleaseRuleOff &&
-          c.release_load_rate * c.slip_smoothing_s >= 1.0) {
-        return Status::error(origin + ": key \"" + names[i] + ".release_load_rate\" (" +
-                             fmt_real(c.release_load_rate) + ") must be below 1 / \"" + names[i] +
-                             ".slip_smoothing_s\" (" + fmt_real(c.slip_smoothing_s) +
-                             "), the largest rate the smoothed load can show, or 1e4 (off)");
+      for (const auto& r : dsp::kCalibrationRules) {
+        if (r.holds(c)) continue;
+        const double a = rule_operand(c, r.key);
+        const double b = rule_operand(c, r.other);
+        return Status::error(origin + ": key \"" + names[i] + "." + r.key + "\" (" + fmt_real(a) +
+                             ") " + r.relation + " \"" + names[i] + "." + r.other + "\" (" +
+                             fmt_real(b) + ")" + r.note);
       }
       const Field& rot = *find_field("rotation_scale");
       for (const auto* v : {&set.paper[i].rotation_scale, &set.paper[i].translation_scale}) {
         for (double x : *v) {
-          if (!in_range(rot, x)) {
+          if (!dsp::field_in_range(rot, x)) {
             return Status::error(
                 origin + ": key \"paper." + names[i] + "." +
                 (v == &set.paper[i].rotation_scale ? "rotation_scale" : "translation_scale") +
@@ -663,13 +583,13 @@ bool format_calibration(const CalibrationSet& set, std::string* text, std::strin
     const Calibration& l = set.sensor[kLeft];
     const Calibration& r = set.sensor[kRight];
     o += "[sensor]\n";
-    for (const auto& f : fields()) {
+    for (const auto& f : kFields) {
       if (same(l, r, f)) o += std::string(f.key) + " = " + value_text(l, f) + "\n";
     }
     const char* names[2] = {"left", "right"};
     for (std::size_t i = 0; i < 2; ++i) {
       o += std::string("\n[") + names[i] + "]\n";
-      for (const auto& f : fields()) {
+      for (const auto& f : kFields) {
         if (!same(l, r, f)) o += std::string(f.key) + " = " + value_text(set.sensor[i], f) + "\n";
       }
     }
