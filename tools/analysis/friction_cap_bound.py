@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-# tacse3 tools: how much of a simulated slide the gel's shear cannot show (accuracy.md item 2 (e)).
+# tacse3 tools: how much of a simulated slide the gel's shear cannot show (the observability bound).
 """Reads a tacse3-sim slide recording (recording.json's "sim" block and truth.csv) and replays
 the simulator's slide law at each pad's deepest contact point (docs/simulator.md §6):
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-# tacse3 tools: replay readings split by the velocity proxy's anchor overlap (accuracy.md 2 (g)).
+# tacse3 tools: replay readings split by how much of the anchored patch the contact mask holds.
 """Reads a `tacse3-replay --out OUT.csv --slip-log SLIP.csv` pair and the recording's truth.csv
 (standard library only) and splits the frames of a time window by how much of the anchored
 patch the contact mask still holds, the quantity the velocity proxy's overlap test compares
