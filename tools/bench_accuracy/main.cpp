@@ -217,6 +217,14 @@ std::string ref_cell(const tt::EvalResult& e) {
   return b;
 }
 
+std::string tracking_cell(const tt::TrackingError& t) {
+  if (!t.valid) return "–";
+  char b[64];
+  std::snprintf(b, sizeof(b), "%.2f / %.2f (%.0f ms)", t.rotation_rms_deg, t.rotation_max_deg,
+                t.rotation_lag_s * 1e3);
+  return b;
+}
+
 bool is_rotation(const SimCase& c) {
   return c.motion[0] == 'r';
 }
@@ -351,7 +359,9 @@ int main(int argc, char** argv) {
                                : "the pipeline has no stick/slip switch yet, so `auto` runs the "
                                  "velocity proxy (docs/replay.md)."));
   add("Errors are final-pose errors of one simulated trial per row (test set: seed 1, preset "
-      "sizes, indentation 1 mm). `fixed−ref`: angle between the final orientations of the "
+      "sizes, indentation 1 mm). `tracking`: the per-frame rotation error from the motion's "
+      "start to the end, RMS / max, with the truth delayed by the lag (0-50 ms, whole frames, "
+      "in brackets) that gives the lowest RMS (dual, joint, auto). `fixed−ref`: angle between the final orientations of the "
       "fixed-point pipeline and the double-precision reference (dsp_ref::DualPipelineRef), both "
       "in the default configuration (dual, joint, auto), with the reference's own error; "
       "`locked`: the same against a reference that takes the fixed pipeline's per-frame "
@@ -364,15 +374,16 @@ int main(int argc, char** argv) {
   add("");
   add("### Table V-B: grasped sphere, mean angular error (deg)");
   add("");
-  add("| axis | angle | paper | ours joint | ours paper | goal | fixed−ref (deg) |");
-  add("|---|---|---|---|---|---|---|");
+  add("| axis | angle | paper | ours joint | ours paper | goal | tracking (deg) | fixed−ref (deg) |");
+  add("|---|---|---|---|---|---|---|---|");
   for (const auto& r : rows) {
     if (!r.vb) continue;
     const double goal = r.c.magnitude <= 30 ? 1.0 : (r.c.magnitude <= 60 ? 2.0 : 3.5);
-    std::snprintf(line, sizeof(line), "| %s | %g | %s | %s | %s | ≤ %.1f | %s |",
+    std::snprintf(line, sizeof(line), "| %s | %g | %s | %s | %s | ≤ %.1f | %s | %s |",
                   r.c.motion.c_str(), r.c.magnitude, fmt(r.paper_vb, 1).c_str(),
                   fmt(r.res(r.slot.dual_joint).errors.final_rotation_error_deg).c_str(),
                   fmt(r.res(r.slot.dual_paper).errors.final_rotation_error_deg).c_str(), goal,
+                  tracking_cell(r.res(r.slot.dual_joint).tracking).c_str(),
                   ref_cell(r.res(r.slot.dual_joint)).c_str());
     add(line);
   }
@@ -405,14 +416,17 @@ int main(int argc, char** argv) {
   add("");
   add("### Table V-D: objects at 30 deg, angular error (deg)");
   add("");
-  add("| object (paper) | sim object, axis | paper | ours joint | ours paper | fixed−ref (deg) |");
-  add("|---|---|---|---|---|---|");
+  add("| object (paper) | sim object, axis | paper | ours joint | ours paper | tracking (deg) | "
+      "fixed−ref (deg) |");
+  add("|---|---|---|---|---|---|---|");
   for (const auto& r : rows) {
     if (!r.vd) continue;
-    std::snprintf(line, sizeof(line), "| %s | %s %s | %s | %s | %s | %s |", r.vd_object.c_str(),
-                  r.c.object.c_str(), r.c.motion.c_str(), fmt(r.paper_vd, 1).c_str(),
+    std::snprintf(line, sizeof(line), "| %s | %s %s | %s | %s | %s | %s | %s |",
+                  r.vd_object.c_str(), r.c.object.c_str(), r.c.motion.c_str(),
+                  fmt(r.paper_vd, 1).c_str(),
                   fmt(r.res(r.slot.dual_joint).errors.final_rotation_error_deg).c_str(),
                   fmt(r.res(r.slot.dual_paper).errors.final_rotation_error_deg).c_str(),
+                  tracking_cell(r.res(r.slot.dual_joint).tracking).c_str(),
                   ref_cell(r.res(r.slot.dual_joint)).c_str());
     add(line);
   }
@@ -488,6 +502,17 @@ int main(int argc, char** argv) {
                   worst <= limit ? "yes" : "**no**");
     add(line);
   };
+  {
+    double worst = 0.0;
+    bool any = false;
+    for (const auto& r : rows) {
+      if (r.vb && r.res(r.slot.dual_joint).tracking.valid) {
+        worst = std::max(worst, r.res(r.slot.dual_joint).tracking.rotation_rms_deg);
+        any = true;
+      }
+    }
+    goal_row("tracking RMS over slide rotations (deg)", 1.5, worst, any);
+  }
   for (double a : {30.0, 60.0, 90.0}) {
     double worst = 0.0;
     bool any = false;

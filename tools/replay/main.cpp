@@ -29,6 +29,19 @@ std::string axis_text(const Eigen::Vector3d& v) {
   return buf;
 }
 
+// The per-frame tracking error, which a controller reading every cycle lives by.
+void print_tracking(std::FILE* report, const tt::TrackingError& t) {
+  if (!t.valid) {
+    std::fprintf(report, "  tracking: no frame after the truth's motion starts\n");
+    return;
+  }
+  std::fprintf(report,
+               "  tracking (%zu frames from the motion's start): rotation RMS %.2f deg, max %.2f "
+               "deg (truth lag %.0f ms); translation RMS %.2f mm, max %.2f mm (lag %.0f ms)\n",
+               t.frames, t.rotation_rms_deg, t.rotation_max_deg, t.rotation_lag_s * 1e3,
+               t.translation_rms_mm, t.translation_max_mm, t.translation_lag_s * 1e3);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -156,6 +169,7 @@ int main(int argc, char** argv) {
                  e.final_rotation_error_deg);
     std::fprintf(report, "  translation: estimated %7.2f mm, truth %7.2f mm -> error %.2f mm\n",
                  e.estimated_translation_mm, e.true_translation_mm, e.final_translation_error_mm);
+    print_tracking(report, sum.tracking);
   }
   if (sum.has_slip_score) {
     const auto& s = sum.slip;

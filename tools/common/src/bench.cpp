@@ -141,6 +141,7 @@ std::string evaluate_case(const SimCase& c, const config::CalibrationSet& cal,
     Runner& r = *runners[k];
     EvalResult& e = (*out)[k];
     e.errors = pose_errors(r.poses, info.truth, info.t_ns);
+    e.tracking = tracking_error(r.poses, info.truth, info.t_ns);
     if (r.ref) {
       const PoseErrors re = pose_errors(r.ref_poses, info.truth, info.t_ns);
       e.reference_error_deg = re.final_rotation_error_deg;

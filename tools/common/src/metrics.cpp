@@ -93,6 +93,92 @@ PoseErrors pose_errors(const std::vector<dsp::Pose>& estimate,
   return e;
 }
 
+std::int64_t motion_start_ns(const std::vector<rec::TruthSample>& truth) {
+  if (truth.empty()) return 0;
+  const dsp::Pose first = to_pose(truth.front());
+  std::vector<double> rot(truth.size()), trans(truth.size());
+  double rot_max = 0.0, trans_max = 0.0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const dsp::Pose p = to_pose(truth[i]);
+    rot[i] = rotation_error_deg(p.q, first.q);
+    trans[i] = (p.p - first.p).norm() * 1e3;
+    rot_max = std::max(rot_max, rot[i]);
+    trans_max = std::max(trans_max, trans[i]);
+  }
+  constexpr double kShare = 0.02, kRotFloorDeg = 0.05, kTransFloorMm = 0.02;
+  const double rot_bar = std::max(kShare * rot_max, kRotFloorDeg);
+  const double trans_bar = std::max(kShare * trans_max, kTransFloorMm);
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if ((rot_max >= kRotFloorDeg && rot[i] >= rot_bar) ||
+        (trans_max >= kTransFloorMm && trans[i] >= trans_bar)) {
+      return truth[i].t_ns;
+    }
+  }
+  return truth.front().t_ns;
+}
+
+namespace {
+
+// The median frame period (ns) of the run's times; 0 with fewer than two frames.
+std::int64_t median_period_ns(const std::vector<std::int64_t>& t_ns) {
+  std::vector<std::int64_t> d;
+  for (std::size_t i = 1; i < t_ns.size(); ++i) d.push_back(t_ns[i] - t_ns[i - 1]);
+  if (d.empty()) return 0;
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  return std::max<std::int64_t>(d[d.size() / 2], 0);
+}
+
+struct LagScore {
+  double rms = 0.0, max = 0.0;
+};
+
+}  // namespace
+
+TrackingError tracking_error(const std::vector<dsp::Pose>& estimate,
+                             const std::vector<rec::TruthSample>& truth,
+                             const std::vector<std::int64_t>& t_ns, double max_lag_s) {
+  TrackingError e;
+  const std::size_t n = std::min(estimate.size(), t_ns.size());
+  if (n == 0 || truth.empty()) return e;
+  e.start_ns = motion_start_ns(truth);
+  std::size_t first = 0;
+  while (first < n && t_ns[first] < e.start_ns) ++first;
+  if (first == n) return e;
+  e.valid = true;
+  e.frames = n - first;
+  const std::int64_t period = median_period_ns(t_ns);
+  const int lags = period > 0 ? static_cast<int>(std::floor(max_lag_s * 1e9 / period + 1e-9)) : 0;
+  bool have_rot = false, have_trans = false;
+  for (int k = 0; k <= lags; ++k) {
+    LagScore rot, trans;
+    for (std::size_t i = first; i < n; ++i) {
+      const dsp::Pose t = truth_pose_at(truth, t_ns[i] - k * period);
+      const double r = rotation_error_deg(estimate[i].q, t.q);
+      const double p = (estimate[i].p - t.p).norm() * 1e3;
+      rot.rms += r * r;
+      trans.rms += p * p;
+      rot.max = std::max(rot.max, r);
+      trans.max = std::max(trans.max, p);
+    }
+    rot.rms = std::sqrt(rot.rms / static_cast<double>(e.frames));
+    trans.rms = std::sqrt(trans.rms / static_cast<double>(e.frames));
+    const double lag_s = static_cast<double>(k * period) * 1e-9;
+    if (!have_rot || rot.rms < e.rotation_rms_deg) {
+      have_rot = true;
+      e.rotation_rms_deg = rot.rms;
+      e.rotation_max_deg = rot.max;
+      e.rotation_lag_s = lag_s;
+    }
+    if (!have_trans || trans.rms < e.translation_rms_mm) {
+      have_trans = true;
+      e.translation_rms_mm = trans.rms;
+      e.translation_max_mm = trans.max;
+      e.translation_lag_s = lag_s;
+    }
+  }
+  return e;
+}
+
 void SlipScore::add(bool detected, bool label) noexcept {
   if (detected && label) ++true_slip;
   if (!detected && !label) ++true_stick;

@@ -288,6 +288,7 @@ RunSummary summarize(const SourceInfo& info, const std::vector<FrameResult>& fra
       t.push_back(f.t_ns);
     }
     s.errors = pose_errors(poses, info.truth, t);
+    s.tracking = tracking_error(poses, info.truth, t);
   }
   if (!info.labels.empty()) {
     for (const auto& l : info.labels) {

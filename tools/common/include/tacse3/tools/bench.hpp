@@ -45,6 +45,7 @@ struct EvalConfig {
 
 struct EvalResult {
   PoseErrors errors{};
+  TrackingError tracking{};
   std::optional<double> reference_error_deg;     // the double reference's final rotation error
   std::optional<double> fixed_vs_reference_deg;  // angle between the two final orientations
   // The same against a reference that takes the fixed pipeline's per-frame discrete decisions

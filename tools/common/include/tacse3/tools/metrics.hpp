@@ -48,6 +48,32 @@ PoseErrors pose_errors(const std::vector<dsp::Pose>& estimate,
                        const std::vector<recording::TruthSample>& truth,
                        const std::vector<std::int64_t>& t_ns);
 
+// The per-frame tracking error a controller sees: for every frame from the motion's start to the
+// end of the run, the geodesic angle between the estimated and true orientation (and the distance
+// between the positions), with the truth delayed by the lag, in whole frame periods from 0 to
+// max_lag_s, that gives the lowest RMS. Rotation and translation each pick their own lag.
+struct TrackingError {
+  bool valid = false;          // there were frames from the motion's start on
+  std::size_t frames = 0;      // frames scored
+  std::int64_t start_ns = 0;   // the motion's start (motion_start_ns)
+  double rotation_rms_deg = 0.0;
+  double rotation_max_deg = 0.0;
+  double rotation_lag_s = 0.0;
+  double translation_rms_mm = 0.0;
+  double translation_max_mm = 0.0;
+  double translation_lag_s = 0.0;
+};
+
+// When the truth starts to move: the first row whose rotation from the first row reaches 2 % of
+// the largest over the table (at least 0.05 deg), or whose translation reaches 2 % of the largest
+// (at least 0.02 mm), so a real rig's pose noise does not start it. The first row's time when the
+// truth never moves that far.
+std::int64_t motion_start_ns(const std::vector<recording::TruthSample>& truth);
+
+TrackingError tracking_error(const std::vector<dsp::Pose>& estimate,
+                             const std::vector<recording::TruthSample>& truth,
+                             const std::vector<std::int64_t>& t_ns, double max_lag_s = 0.05);
+
 // Confusion counts of a per-frame, per-sensor stick/slip detector against sim_labels.csv
 // (only frames labelled in_contact are scored).
 struct SlipScore {

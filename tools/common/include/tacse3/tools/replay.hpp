@@ -118,6 +118,7 @@ void write_csv_row(std::FILE* f, const FrameResult& r);
 struct RunSummary {
   bool has_truth = false;
   PoseErrors errors{};
+  TrackingError tracking{};  // per frame from the motion's start (with truth)
   bool has_slip_score = false;
   SlipScore slip{};
   double valid_fraction = 0.0;  // frames with a valid estimate
