@@ -10,7 +10,7 @@
 // tensor, its inverse and all template statistics are fixed per keyframe; an iteration only
 // samples the current image and accumulates the mismatch vector.
 //
-// Fixed-point formats (docs/dsp.md has the full table with ranges and rounding):
+// Fixed-point formats (docs/dsp/flow.md has the full table with ranges and rounding):
 //   I, T       U8.2 pyramid samples, 0..1020 (luma * 4)
 //   g          gx, gy = T(x+1) - T(x-1): int16, |g| <= 1020 (2 * U8.2 per level px)
 //   h          horizontal bilinear pass (32 - fx) a + fx b: int16 U8.7, 0..32640, exact
@@ -45,7 +45,7 @@ constexpr std::int64_t kN = kFlowWindowPixels;
 constexpr std::int32_t kWindowCentreQ16 = (kFlowWindow - 1) * kHalf;
 // Sub-pixel sampling resolution: positions are rounded to 1/32 px (Q5) before sampling; the
 // Gauss-Newton step computed there is added to the rounded position, so the rounding only
-// enters at second order (see docs/dsp.md).
+// enters at second order (see docs/dsp/flow.md).
 constexpr int kPosFrac = 5;
 constexpr int kQ16ToPos = 16 - kPosFrac;
 // Window origins are kept one pixel inside the image: every template pixel then has both
@@ -327,9 +327,8 @@ inline TemplateSums template_sums(const FlowWindowTemplate& tpl, const std::int1
 // Neighbour consensus (a PIV-style outlier test) on one grid level: a tracked point (ok = 1) is
 // rejected when fewer than half of its tracked 8-neighbours agree with it within `tol` (Q16, per
 // axis), or when fewer than two agree at all: a lone match, or a pair of matches that only agree
-// with each other, in a failed region is more likely wrong than right (such a pair, 10 px off,
-// survived a cold 16 px jump once max_residual_ratio was 0.30). Decisions use the flags as they
-// were on entry.
+// with each other, in a failed region is more likely wrong than right. Decisions use the flags
+// as they were on entry.
 void reject_outliers(int gw, int gh, const std::int32_t* fx, const std::int32_t* fy,
                      std::uint8_t* ok, std::int32_t tol, std::uint8_t* scratch) noexcept {
   std::copy_n(ok, gw * gh, scratch);

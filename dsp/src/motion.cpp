@@ -238,7 +238,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // m: every cell of Ω_t (translation, shear). m_stayed: the cells also in Ω_{t−1}, the only ones
   // with a shear increment: a cell that (re-)enters Ω was usually not tracked by the flow while
   // it was out, holds a stale shear, and its first increment would be the whole catch-up at the
-  // patch rim (docs/accuracy.md: an uncalibrated sphere rz 4° stick read as 6.84°).
+  // patch rim, read as rotation.
   // m_held: the cells of Ω in the anchor (the velocity proxy's region while the shear is a drag).
   ContactMoments m, m_stayed, m_anchored, m_held;
   ProxySums sum_shear, sum_increment, sum_anchored, sum_held;
@@ -319,13 +319,10 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // and its relative rate of fall ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) · Δt), EMA the
   // exponential smoothing of X (so ρ_L ≤ 1/slip_smoothing_s at a constant frame period). When
   // the pads open, the contact loses its load and the gel it lets go of springs back: the
-  // shear's rigid content relaxes about as fast as the load falls (cylinder ry 2° held, then
-  // released over 0.3 s: ρ 5.4/s against ρ_L 3.7/s at the frame the detector used to call a
-  // slip, 9.1/s against 6.5/s at the next), and the displacement proxy reads the spring-back as
-  // the object moving back. A grasp holds its load: ρ_L ≤ 2.7/s during the simulator's stick
-  // motions, ≤ 4.8/s in its slides whose contact stays (5.7/s for two frames as a screwdriver
-  // handle's flute passes), peaks of 6.5/s up to the ceiling while a contact is released over
-  // 0.3 s (docs/dsp.md §4.2b).
+  // shear's rigid content relaxes about as fast as the load falls, which the detector would
+  // call a slip, and the displacement proxy reads the spring-back as the object moving back.
+  // A grasp, sticking or sliding, holds its load; a release sheds it much faster
+  // (docs/dsp/motion.md, release).
   // L_{t−1} is prev_sz_ (kept for the sliding rule); a contact's first frame starts the EMA.
   if (m.n > 0) {
     const double alpha = content_alpha(dt_s, smoothing_s_);
@@ -352,8 +349,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       // change dX is read from the increments over Ω_t ∩ Ω_{t−1} (smoothed alike, which equals
       // the change of the smoothed X while Ω stays the same): cells entering or leaving Ω at the
       // rim carry shear they did not just gain or lose, and a rim burst read as a relaxation
-      // started false slips in sticking contacts (3° torsion of a sphere at 1.5 mm
-      // indentation read as 30°).
+      // would start false slips in sticking contacts.
       const double alpha = content_alpha(dt_s, smoothing_s_);
       const Eigen::Vector3d& raw = shear_content;
       const Eigen::Vector3d step = planar_content(mi, c_displacement_ * kQ16Lsb);
@@ -382,7 +378,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
         // slip_on_frames frames (the first frame of a contact counts, its change reads zero) it
         // is confirmed stuck; a loaded contact at rest may be sliding steadily at the friction
         // limit and needs stick_confirm_s. This drops what the velocity proxy read while the
-        // contact formed (docs/accuracy.md item 5: a growing mask's centroid moves ~0.2 mm).
+        // contact formed (a growing mask's centroid moves with nothing sliding).
         const bool unloaded = out.shear_shift_m <= min_shift_m_;
         unloaded_rest_frames_ = rest && unloaded ? unloaded_rest_frames_ + 1 : 0;
         if (evidence_frames_ >= on_frames_) {
@@ -409,9 +405,9 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // Final proxy of this frame, and (kAuto while sticking) the velocity proxy's reading beside it.
   // The displacement proxy reads its increments over the anchored patch: a tangential load
   // stretches the gel behind the patch, 𝒢 reads the stretch as normal load and Ω grows over gel
-  // that does not move with the object (a 4° stick rotation of a sphere about x: 106 cells
-  // before the motion, 315 after), which diluted the mean increment more the larger the motion
-  // (docs/dsp.md §4.2c). Over Ω_t ∩ Ω_{t−1} alone if the anchor and Ω no longer share a cell.
+  // that does not move with the object, which would dilute the mean increment more the larger
+  // the motion (docs/dsp/motion.md, patch anchor). Over Ω_t ∩ Ω_{t−1} alone if the anchor and
+  // Ω no longer share a cell.
   out.velocity_differs = automatic && sticking;
   out.moments = sticking ? (ma.n > 0 ? ma : mi) : mvel;
   // A sticking contact whose load falls faster than release_load_rate is being let go: the
@@ -432,8 +428,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   }
   // The sliding rule's centroid is weighted by the contact points' height z (the indentation
   // estimate): cells at the rim of Ω carry z ≈ 0, so the cells that flicker in and out of Ω
-  // there, and those the hysteresis keeps in Ω after the patch has moved on, hardly move it
-  // (docs/accuracy.md item 5). Without any height (flat contact, height_gain 0) the plain mean.
+  // there, and those the hysteresis keeps in Ω after the patch has moved on, hardly move it.
+  // Without any height (flat contact, height_gain 0) the plain mean.
   const bool weighted = m.sz > 0 && prev_sz_ > 0;
   const Eigen::Vector3d slide_point =
       weighted

@@ -57,7 +57,8 @@ struct BlockFlowConfig {
   // Match quality: zero-mean residual energy / zero-mean template energy after the last
   // iteration (0 = perfect match; an unrelated or blank frame gives ~1 or more). A correct match
   // on strained, shaded gel under contact (a fine, low-contrast pattern with sensor noise) leaves
-  // up to ~0.3: at 0.15, 12 % of the grid around a pressed patch went untracked (docs/dsp.md).
+  // a sizeable residual; a tighter bound leaves the grid around a pressed patch untracked
+  // (docs/dsp/flow.md).
   double max_residual_ratio = 0.30;
   double max_step_px = 2.0;        // per-iteration step clamp
   double converged_step_px = 0.1;  // the last step must be below this for a valid point
@@ -65,9 +66,8 @@ struct BlockFlowConfig {
   // chained displacement within this tolerance (working px) take the direct value, which
   // resets the drift of the chain (see BlockFlow::re_anchor()). 0 disables re-anchoring. The
   // default, the largest allowed, lets every valid direct match replace the chain: a chain can
-  // take a wrong match while the gel springs back after a slide (1.7 working px off on the
-  // simulator's screwdriver handle) and would keep that error for good under a tight tolerance,
-  // which protected the wrong chain against the right direct match (docs/dsp.md, stage 2).
+  // take a wrong match while the gel springs back after a slide, and a tight tolerance would
+  // protect the wrong chain against the right direct match for good (docs/dsp/flow.md).
   // "Every" holds because with the default iterations a match moves at most about 6 px from its
   // warm start (4 steps of at most max_step_px per component); more or longer steps could
   // exceed the tolerance.
@@ -88,7 +88,7 @@ struct FlowWindowTemplate {
 
 // Per-window model, precomputed when a keyframe is taken (inverse-compositional LK: the
 // template, its gradients and the inverse structure tensor stay fixed until the next keyframe).
-// Formats are listed at the top of block_flow.cpp and in docs/dsp.md.
+// Formats are listed at the top of block_flow.cpp and in docs/dsp/flow.md.
 struct FlowWindowModel {
   // Block-floating-point inverse of the zero-mean, gain-eliminated structure tensor H64:
   // H64^-1 = [inv_a inv_b; inv_b inv_c] * 2^-(shift + 12). Mantissas |.| < 2^22.

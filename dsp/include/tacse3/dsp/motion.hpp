@@ -70,21 +70,18 @@ enum class TranslationSource : std::uint8_t {
                       // material points in both masks
 };
 
-// The velocity proxy's region (docs/dsp.md §4.2d). A drag (the in-plane part of a slide: a
-// rotation about an in-plane axis or a translation) moves the gel over the patch rigidly and
-// the gel around it less, so the density 𝒢 reads compression ahead of the patch and expansion
+// The velocity proxy's region (docs/dsp/motion.md, drag region). A drag (the in-plane part of a
+// slide: a rotation about an in-plane axis or a translation) moves the gel over the patch rigidly
+// and the gel around it less, so the density 𝒢 reads compression ahead of the patch and expansion
 // behind it, and Ω leaves the patch's leading part for the stretched gel behind it, whose shear
-// has decayed: a no-cap sphere rx 30° (`--friction 5`) read 34.12° in 0.5 s and 49.72° in 3 s,
-// the same angle (a calibration fitted with the cap). Over the patch anchored before the load, the
-// shear is the patch's own, and the reading does not depend on the speed. A torsion has no
-// divergence and leaves Ω in place, while an elongated patch turns away from its anchor; a
-// translation carries the patch off its anchor. So Ω ∩ anchor is read only while the shear's
-// uniform part exceeds kVelocityAnchorDragRatio times its torsion (the torsion as the
-// displacement on the rms lever, planar_content over Ω) and Ω ∩ anchor holds at least
-// kVelocityAnchorMinOverlap of the smaller of Ω and the anchor (a tilting flat face keeps a
-// strip of its anchored face: a cube's rx 30° goes from 380 cells to 119, 66 of them anchored;
-// a translation leaves both); otherwise all of Ω, as before (also on a frame without shear, and
-// before the first anchor).
+// has decayed: the reading would depend on the speed of the slide. Over the patch anchored before
+// the load, the shear is the patch's own. A torsion has no divergence and leaves Ω in place,
+// while an elongated patch turns away from its anchor; a translation carries the patch off its
+// anchor. So Ω ∩ anchor is read only while the shear's uniform part exceeds
+// kVelocityAnchorDragRatio times its torsion (the torsion as the displacement on the rms lever,
+// planar_content over Ω) and Ω ∩ anchor holds at least kVelocityAnchorMinOverlap of the smaller
+// of Ω and the anchor (a tilting flat face keeps a strip of its anchored face; a translation
+// leaves both); otherwise all of Ω (also on a frame without shear, and before the first anchor).
 inline constexpr double kVelocityAnchorDragRatio = 1.0;
 inline constexpr double kVelocityAnchorMinOverlap = 0.5;
 
@@ -131,12 +128,13 @@ struct SensorMotion {
   bool releasing = false;
   // The displacement proxy's patch anchor was set to this frame's Ω (every mode): the contact's
   // first frame, a tangentially unloaded shear (|X| ≤ slip_min_shift_m, X over Ω unsmoothed),
-  // or the frame a slide ended. Increments are read over Ω_t ∩ Ω_{t−1} ∩ anchor (docs/dsp.md
-  // §4.2c).
+  // or the frame a slide ended. Increments are read over Ω_t ∩ Ω_{t−1} ∩ anchor
+  // (docs/dsp/motion.md, patch anchor).
   bool anchor_set = false;
-  // The velocity proxy was read over Ω ∩ anchor instead of all of Ω (every mode; docs/dsp.md
-  // §4.2d): the shear over Ω is a drag (|t| > |θ|·L in planar_content, kVelocityAnchorDragRatio)
-  // and Ω and the anchor share at least kVelocityAnchorMinOverlap of the smaller one's cells.
+  // The velocity proxy was read over Ω ∩ anchor instead of all of Ω (every mode;
+  // docs/dsp/motion.md, drag region): the shear over Ω is a drag (|t| > |θ|·L in
+  // planar_content, kVelocityAnchorDragRatio) and Ω and the anchor share at least
+  // kVelocityAnchorMinOverlap of the smaller one's cells.
   bool velocity_anchored = false;
   // The cells the velocity proxy read: |Ω ∩ anchor| or |Ω| (every mode), and |Ω ∩ anchor|
   // (0 without an anchor), what the overlap test compares.
@@ -185,7 +183,7 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 //        kVelocity this includes a centroid shift from pressing harder on a tilted object, or
 //        from pressure moving within the patch (rolling), which no rule here can tell from a
 //        slide; kAuto reads those, while the contact sticks, from the material points.
-//  - Velocity proxy ṽ (issue item 12): kVelocity ṽ = c_velocity · shear over Ω, or over
+//  - Velocity proxy ṽ: kVelocity ṽ = c_velocity · shear over Ω, or over
 //    Ω ∩ anchor while the shear is a drag and Ω and the anchor share at least half the smaller
 //    one's cells (above); kDisplacement
 //    ṽ = c_displacement · (shear_t − shear_{t−1}) / Δt over Ω_t ∩ Ω_{t−1}, the previous shear
@@ -193,15 +191,16 @@ SensorMotion velocity_reading(const SensorMotion& m) noexcept;
 //  - Rotation: int64 moments over the proxy's cells, then in double the own-frame normal
 //    equations and solve3 with λ = λ_rel tr/3 + N · lever_floor²; per-axis scales
 //    rotation_scale (velocity proxy) or rotation_scale ⊙ displacement_rotation_ratio.
-//  - Release (docs/dsp.md §4.2b): the normal load L = Σ z over Ω and its relative rate of fall
+//  - Release (docs/dsp/motion.md): the normal load L = Σ z over Ω and its relative rate of fall
 //    ρ_L, smoothed like X, in every mode. A sticking contact (kDisplacement, or kAuto not
 //    slipping) with ρ_L > release_load_rate is being let go (the gel springs back): this frame's
 //    chosen reading is dropped (`releasing`). kAuto's onset counts only ρ − max(0, ρ_L), and no
 //    frame with ρ_L > release_load_rate.
 //  - kAuto (per frame): both proxies' moments are summed in the same pass; the stick/slip
-//    detector (Calibration, docs/dsp.md) picks one. While sticking, the velocity proxy's reading
-//    (its ω and the sliding translation rule) is reported beside the displacement proxy's; the
-//    dual pipeline fuses both and SlipPayback pays back their fused difference at a slip onset.
+//    detector (Calibration, docs/dsp/motion.md) picks one. While sticking, the velocity proxy's
+//    reading (its ω and the sliding translation rule) is reported beside the displacement
+//    proxy's; the dual pipeline fuses both and SlipPayback pays back their fused difference at a
+//    slip onset.
 class MotionEstimator {
  public:
   MotionEstimator() noexcept;  // configured with Calibration{} defaults
@@ -212,7 +211,7 @@ class MotionEstimator {
   void reset() noexcept;
   // Forget the previous frame but keep the patch anchor (call after a gap in the stream or a
   // missed frame): a tangential load held across the gap has left the gel stretched, and the
-  // Ω of the next frame would anchor the stretched extent (docs/dsp.md §4.2c). The next frame
+  // Ω of the next frame would anchor the stretched extent (docs/dsp/motion.md). The next frame
   // without contact, or tangentially unloaded, replaces the anchor as usual. While sliding, the
   // anchor is dropped (the slide's end, which re-anchors, may fall in the gap).
   void restart() noexcept;

@@ -6,7 +6,7 @@
 
 namespace tacse3::dsp {
 
-// kAuto (docs/dsp.md §4.2a). The stick/slip detector recognises a slide only once its shear
+// kAuto (docs/dsp/motion.md). The stick/slip detector recognises a slide only once its shear
 // relaxes, so the first part of every slide is read with the displacement proxy. Beside the
 // fused twist of the chosen proxies, the dual pipeline fuses the same frame read with the
 // velocity proxy; the difference, integrated (the deficit D, [rad; m] in G), is what kVelocity
