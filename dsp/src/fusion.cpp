@@ -119,8 +119,8 @@ void fuse_joint(const std::array<const SensorMotion*, 2>& s, const FusionConfig&
       // One pad: only the rotation about its normal n. A rotation about an in-plane axis shears
       // a flat pad like a translation does; the 3x3 solve would read those two components from
       // the sub-millimetre lever of the indentation's heights alone, where a few µm of shear
-      // noise per frame become rad/s (a pad dropping out for a few frames of a dual grasp turned
-      // a 4° torsion into 16.8°). They are reported as 0: the 1-D least squares along n,
+      // noise per frame become rad/s (a pad dropping out for a few frames of a dual grasp would
+      // turn the object by degrees). They are reported as 0: the 1-D least squares along n,
       // ω = n (nᵀAᵀb)/(nᵀAᵀA n + λ), with the λ of the 3x3 solve. rank = 1 says so.
       const int i = (out.rotation_sensors & kSensor1) != 0 ? 0 : 1;
       const Eigen::Vector3d n = cfg.extrinsics[static_cast<std::size_t>(i)].R_GS.col(2);

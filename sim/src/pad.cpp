@@ -486,13 +486,13 @@ void PadPhysics::compute_labels(bool sliding) noexcept {
 // object carried it since the motion started, bulge and all: it sat at c − U_t(c) then, displaced
 // by that moment's bulge U_n0, so U(c) = U_t(c) + U_n0(c − U_t(c)) over the patch (docs/
 // simulator.md §6). The bond's correction to the current bulge, B = U_n0(c − U_t(c)) − U_n(c), is
-// set on the patch and spread outside it like U_t. A plain sum U_t + U_n made a stuck torsion's
-// bulged gel turn 1/(1 − k) times as fast as the object (U_n ≈ k r inside the patch): the bulge
-// vector stayed unturned while the material carrying it turned. Where the bulge moves with the
-// object (a translation) B is ≈ 0. A slide is not bonded (B = 0): the bulge follows the
-// indenter. U_n0 is sampled bilinearly between cells. load_ratio (the commanded indentation over
-// the grasp's, in [0, 1]) scales U_n0: as the pads open the bonded gel's bulge relaxes with the
-// load, so B falls to 0 with the contact instead of vanishing with its last cell.
+// set on the patch and spread outside it like U_t. A plain sum U_t + U_n would make a stuck
+// torsion's bulged gel turn 1/(1 − k) times as fast as the object (U_n ≈ k r inside the patch):
+// the bulge vector would stay unturned while the material carrying it turns. Where the bulge
+// moves with the object (a translation) B is ≈ 0. A slide is not bonded (B = 0): the bulge
+// follows the indenter. U_n0 is sampled bilinearly between cells. load_ratio (the commanded
+// indentation over the grasp's, in [0, 1]) scales U_n0: as the pads open the bonded gel's bulge
+// relaxes with the load, so B falls to 0 with the contact instead of vanishing with its last cell.
 void PadPhysics::bond_normal(bool sliding, bool moving, double load_ratio) noexcept {
   if (sliding || !moving || !bond_captured_) {
     // Nothing bonded yet: keep the bulge as it is now. Before the motion B = 0 (and a slide is

@@ -7,7 +7,8 @@
 
 namespace tacse3::dsp {
 
-// Conventions used by every Q-format helper in this file (see docs/dsp.md, "Scaling and overflow"):
+// Conventions used by every Q-format helper in this file (see docs/dsp/flow.md, "Scaling and
+// overflow"):
 //  - A value in format QF of an integer type T represents  raw * 2^-F.
 //  - Rounding is round-half-up (towards +inf): add 2^(s-1) before an arithmetic right shift by s.
 //    This is what CMSIS-DSP calls "rounding"; it is cheap and has no sign branch. Its bias is

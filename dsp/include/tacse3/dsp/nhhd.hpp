@@ -30,11 +30,9 @@ namespace tacse3::dsp {
 //  2. A padded domain: the Poisson problems live on the grid plus kNhhdPad* cells of padding with
 //     no sources; on the ring just outside the padding the potentials are set to the free-space
 //     potential of the current sources, truncated after the quadrupole term (multipole boundary,
-//     default), or to 0 (NhhdFarBoundary::kZero). With the multipole ring a padding of 3-5 cells
-//     is enough: measured error against the Green's-function reference is 0.1-0.3 % (RMS,
-//     relative to |w|) for sources inside the grid and 1.5 % for a rotation/expansion filling the
-//     whole grid; a zero ring gives ~10 % here and would need > 16 cells of padding for 2 %
-//     (docs/dsp.md).
+//     default), or to 0 (NhhdFarBoundary::kZero). The multipole ring carries the far field the
+//     padding cuts off, so a padding of 3-5 cells is enough; a zero ring would need several
+//     times that padding for the same error (docs/dsp/fields.md).
 //
 // Solver (fixed cost per call): each Poisson problem is solved by `cycles` V-cycles on the padded
 // 47 x 39 grid (coarse levels 23 x 19, 11 x 9, 5 x 4), warm-started from the previous call's

@@ -53,7 +53,7 @@ struct WindowRef {
 };
 
 // The fixed-point path's discrete decisions of one frame, for the "decision-locked" comparison
-// only (docs/dsp.md, "Fixed point vs the double reference"): which points dsp::BlockFlow reported
+// only (docs/dsp/reference.md): which points dsp::BlockFlow reported
 // tracked (dsp::SensorFields::flow_valid) and whether it took this frame as its next keyframe.
 // Near a threshold (convergence, residual ratio, neighbour consensus, the keyframe gates) the two
 // arithmetics can decide differently; following these takes those crossings out of the numeric

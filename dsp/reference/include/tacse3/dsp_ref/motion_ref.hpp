@@ -80,7 +80,7 @@ struct SensorMotionRef {
 // anchor was set to the frame's Ω and `velocity_anchored` whether the velocity proxy read
 // Ω ∩ anchor (every mode; without `has_anchor` the reference decides both). Used
 // ONLY to measure the numeric fixed−ref difference with the
-// detector's threshold crossings taken out ("decision-locked"; docs/dsp.md).
+// detector's threshold crossings taken out ("decision-locked"; docs/dsp/reference.md).
 struct SlipDecision {
   bool slipping = false;
   bool stick_confirmed = false;

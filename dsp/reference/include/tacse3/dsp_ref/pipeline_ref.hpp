@@ -15,22 +15,23 @@
 
 namespace tacse3::dsp_ref {
 
-// How the reference chain is run (docs/dsp.md, "Fixed point vs the double reference").
+// How the reference chain is run (docs/dsp/reference.md).
 struct ReferenceOptions {
   // Block flow on the fixed-point path's sampling grid (BlockFlowRef::set_fixed_point_sampling):
   // positions rounded to 1/32 px, the step added to the rounded position, stop when the rounded
   // position repeats. Off (default): exact positions, |step| < 1/64 px, i.e. the converged LK
   // solution of Eq. (dense_flow), which the fixed path approximates to second order. On is a
   // diagnostic: its discrete stopping rule makes the two chains take different iteration counts
-  // where the double arithmetic rounds a position differently (measured: better agreement on
-  // some simulated recordings, worse on the synthetic scenes of test_pipeline).
+  // where the double arithmetic rounds a position differently, so it does not agree better
+  // everywhere.
   bool fixed_point_sampling = false;
 };
 
 // The fixed-point pipeline's discrete decisions for one sensor and frame, to report a
-// "decision-locked" fixed−ref difference next to the free-running one (docs/dsp.md). Each part is
-// optional: null pointers leave that decision to the reference. Taken from dsp::SensorFields
-// (flow_valid, contact.mask), dsp::SensorResult (keyframe_switched) and dsp::SensorMotion.
+// "decision-locked" fixed−ref difference next to the free-running one (docs/dsp/reference.md).
+// Each part is optional: null pointers leave that decision to the reference. Taken from
+// dsp::SensorFields (flow_valid, contact.mask), dsp::SensorResult (keyframe_switched) and
+// dsp::SensorMotion.
 struct FixedDecisions {
   const SlipDecision* slip = nullptr;
   FlowDecision flow{};  // flow.valid null: the reference's own flow decisions

@@ -16,7 +16,8 @@ class Simulator;
 
 namespace tacse3::hal {
 
-// The scene, as the board file's [sim] table declares it (docs/hal.md, "sim camera backend").
+// The scene, as the board file's [sim] table declares it (docs/hal-camera.md, "sim camera
+// backend").
 struct SimSceneConfig {
   std::string object = "sphere";  // a tacse3::sim object preset (sim::object_preset_names())
   std::string motion = "rz";      // rx ry rz tx ty
