@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // tacse3-fixref: the fixed-point pipeline (dsp::DualPipeline through the replay engine) against
 // the double-precision reference (dsp_ref::DualPipelineRef) on ONE simulated recording, per
-// velocity-proxy mode, with per-stage and per-frame differences (docs/accuracy.md, item 7).
+// velocity-proxy mode, with per-stage and per-frame differences (docs/dsp/reference.md).
 #include <CLI/CLI.hpp>
 #include <array>
 #include <cmath>
@@ -77,7 +77,7 @@ struct Runner {
   std::array<long, 2> locked_switches{}, fixed_switches{};
   // Accumulated diagnostics.
   long slip_mismatch = 0, frames_contact = 0, mask_mismatch_cells = 0, mask_cells = 0;
-  // The region choices of dsp/src/motion.cpp (docs/dsp.md §4.2c, §4.2d): which sensor-frames set
+  // The region choices of dsp/src/motion.cpp (docs/dsp/motion.md): which sensor-frames set
   // the displacement proxy's anchor, and which read the velocity proxy over Ω ∩ anchor.
   long anchor_set_mismatch = 0, velocity_anchored_mismatch = 0;
   FieldDiff flow, smoothed, d, r, k, shear, shear_in_contact, fz, density;

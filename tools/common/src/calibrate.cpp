@@ -31,10 +31,9 @@ constexpr double kWeightFloorRad = 3.0 / kDeg;
 // A recording whose truth rotates this much or more about an axis excites that axis: its per-axis
 // scales are fitted. The truth is exact, so this only keeps out recordings that do not rotate
 // about the axis (a translation, or another axis's motion); a stick motion of 1-2 deg is read with
-// the displacement proxy to a few hundredths of a degree and does excite it. (At 3 deg, the
-// weight floor, the benchmark's stick ry 2 deg recordings left the displacement proxy's y scale
-// unfitted: it took the velocity proxy's, and a 2 deg stick about y read 17 % (sphere) to 35 %
-// (cylinder) over.)
+// the displacement proxy closely and does excite it. (At 3 deg, the weight floor, an axis with
+// only 2 deg stick recordings would leave the displacement proxy's scale unfitted: it would take
+// the velocity proxy's, and a small stick about that axis would read well over.)
 constexpr double kExciteFloorRad = 1.0 / kDeg;
 // Sanity bounds of the joint fusion's per-axis rotation scales: that fusion is in rad/s with the
 // physical lever arm, so a scale far from 1 would only fit noise.
@@ -719,9 +718,9 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
   log("stage 2b/3: stick/slip detector thresholds (kAuto, one run per candidate)");
   // The minimum shift is a candidate too: the grasp itself leaves a small planar shear content
   // (the bulge is not exactly curl- and translation-free once d enters the shear), and a
-  // torsion that starts from it reads as that content relaxing. Measured on the calibration
-  // set's sphere rz 3° (stick): about 35 µm at the start of the motion, which the 20 µm default
-  // let through as a slip onset (18-40° of error).
+  // torsion that starts from it reads as that content relaxing. That content can exceed the
+  // default minimum shift at the start of a small stick torsion and pass as a slip onset, whose
+  // payback then costs far more than the motion.
   struct DetectorCandidate {
     double relax_rate_on;
     int on_frames;
@@ -771,10 +770,10 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
         cost[k] += rot * rot + tr * tr;
       }
     }
-    // Costs within kDetectorCostTie of the smallest are a tie: on the benchmark's set most
-    // candidates agree to the third digit and the last digits (a thousandth of a degree on a
-    // row) picked between them by accident. A tie goes to the first candidate in the list, the
-    // most sensitive detector (smallest shift, lowest rate, fewest frames).
+    // Costs within kDetectorCostTie of the smallest are a tie: candidates often agree to the
+    // third digit, and the last digits would pick between them by accident. A tie goes to the
+    // first candidate in the list, the most sensitive detector (smallest shift, lowest rate,
+    // fewest frames).
     const double lowest = *std::min_element(cost.begin(), cost.end());
     std::size_t best = 0;
     while (cost[best] > lowest * (1.0 + kDetectorCostTie)) ++best;

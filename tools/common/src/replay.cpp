@@ -88,7 +88,7 @@ dsp::VelocityProxy pipeline_proxy(ProxyMode m) noexcept {
     case ProxyMode::kVelocity:
       return dsp::VelocityProxy::kVelocity;
     case ProxyMode::kAuto:
-      // The pipeline's per-frame, per-sensor stick/slip detector (docs/dsp.md).
+      // The pipeline's per-frame, per-sensor stick/slip detector (docs/dsp/motion.md).
       return dsp::VelocityProxy::kAuto;
   }
   return dsp::VelocityProxy::kVelocity;

@@ -14,8 +14,8 @@ namespace tacse3::tools {
 // re-anchored and lost points), contact mask and stick/slip decision. The pointers refer to the
 // pipeline's own fields and stay valid until its next frame. A sensor without a frame this time
 // is not processed by the reference either (DualPipelineRef::process gets no view for it), so
-// its stale fields are never read. docs/dsp.md, "Fixed point vs the double reference", says what
-// the decision-locked figure measures.
+// its stale fields are never read. docs/dsp/reference.md says what the decision-locked figure
+// measures.
 class DecisionFollower {
  public:
   // levels: which decisions to take; by default all of them.
