@@ -176,7 +176,7 @@ void StreamWriter::run() {
     tail_.store(tail + 1, std::memory_order_release);
     // Counted only once the slot is free again (release, paired with stats()' acquire): a
     // producer pacing itself on pushed − written < ring_frames then always finds room. Counted
-    // before the release, a push in between was dropped as "ring full" (seen under qemu).
+    // before the release, a push in between could be dropped as "ring full".
     if (wrote) n_.written.fetch_add(1, std::memory_order_release);
   }
 }
