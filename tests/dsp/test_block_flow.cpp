@@ -100,8 +100,9 @@ void report(const char* what, const FlowError& e) {
 
 // --- Accuracy against analytic warps -------------------------------------------------------
 
-// docs/dsp.md quotes this size: the object holds every frame's scratch (no heap, no large stack
-// frames), one per sensor in static storage. The bound is the budget that statement relies on.
+// docs/dsp/flow.md quotes this size: the object holds every frame's scratch (no heap, no large
+// stack frames), one per sensor in static storage. The bound is the budget that statement relies
+// on.
 TEST(BlockFlow, StaticFootprint) {
   std::printf("  sizeof(BlockFlow) = %zu bytes\n", sizeof(BlockFlow));
   EXPECT_LE(sizeof(BlockFlow), std::size_t{1280} * 1024);
@@ -373,11 +374,11 @@ TEST(BlockFlow, EmptyAndSaturatedFramesAreFlaggedAndHeld) {
 }
 
 // The other side of max_residual_ratio: a frame of a different random-dot pattern (a swapped
-// sensor, a wrong tare) must not be "tracked". The bound was raised from 0.15 to 0.30 so that
-// strained, shaded gel under contact stays tracked (tools_test_accuracy
-// TheFlowTracksThePressedGelEverywhere); an unrelated window leaves ~1 of its template energy, and
-// the rare chance match below 0.30 has no two neighbours agreeing with it (neighbour consensus:
-// with the old "one tracked neighbour suffices" rule, 4 and 2 points of seeds 8 and 9 passed).
+// sensor, a wrong tare) must not be "tracked". The bound is 0.30 so that strained, shaded gel
+// under contact stays tracked (tools_test_accuracy TheFlowTracksThePressedGelEverywhere); an
+// unrelated window leaves ~1 of its template energy, and the rare chance match below 0.30 has no
+// two neighbours agreeing with it (neighbour consensus: a single agreeing neighbour would let
+// chance matches through).
 TEST(BlockFlow, AnUnrelatedPatternIsNotTracked) {
   auto f = make_flow();
   for (const std::uint64_t seed : {7u, 8u, 9u}) {
@@ -575,7 +576,7 @@ TEST(BlockFlowReference, FlowAgreesWithDoubleReference) {
 // With the reference sampling on the fixed-point grid (1/32 px positions, same stopping rule),
 // only the arithmetic differs: the floor-rounded vertical bilinear pass (<= 1/64 luma per
 // sample), U8.7 residuals, the Q16 gain coupling and steps. Tighter agreement: >= 60 dB, max
-// 0.01 px (measured 64-74 dB, 0.007 px).
+// 0.01 px.
 TEST(BlockFlowReference, FlowAgreesOnTheFixedPointSamplingGrid) {
   const Warp warps[] = {Warp::shift(1.1, -0.7), Warp::affine(1.02, 0.015, -0.01, 0.985, 1.1, -0.7)};
   for (const Warp& w : warps) {
@@ -725,8 +726,8 @@ TEST(BlockFlowReference, FollowsTheGivenDecisions) {
     }
     // The strict reference tracks the points whose model its own test rejected (held at their
     // tare value they would be off by the whole displacement, up to 7 px). Its estimates there
-    // are its own, not the fixed path's, so they are looser than the fixed path's 0.06 px:
-    // measured 0.02-0.16 px RMS per frame, worst at the top border after a keyframe switch.
+    // are its own, not the fixed path's, so they are looser than the fixed path's 0.06 px,
+    // worst at the top border after a keyframe switch.
     double sum = 0.0;
     int n = 0;
     for (int gy = 0; gy < kGridHeight; ++gy) {

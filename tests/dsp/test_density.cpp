@@ -186,8 +186,7 @@ TEST(Density, MatchesDoubleReference) {
   // displacements (<= 2^-11 px each, so <= 2^-10 px per distance component), Q15 LUT entries
   // (0.5 LSB), interpolation (< 1e-6) and the Q16 output. The distance rounding dominates:
   // |dK/dr| <= e^-1/2 / sigma = 0.15 / px gives <= 2e-4 per kernel term; 36 terms of one sign over
-  // D0 ~ 6.3 would be ~70 LSB of G, random signs give a few LSB (measured max 8 LSB, 60-69 dB for
-  // RMS G of 0.03-0.08). Thresholds: 55 dB and 16 LSB.
+  // D0 ~ 6.3 would be ~70 LSB of G, random signs give a few LSB. Thresholds: 55 dB and 16 LSB.
   for (int seed = 1; seed <= 4; ++seed) {
     f::Rng rng(static_cast<std::uint64_t>(seed));
     const GridVectorD ud0 = f::random_smooth(rng, 2.5, 0.05);

@@ -80,8 +80,8 @@ FusedMotion observe(const Layout& s, const Vector6d& xi) {
   return out;
 }
 
-// Tolerances: ω from Q16 shear (≤ 2^-17 shear units per point) and nm positions: relative 2e-4
-// (measured ≤ 5e-5); t from Q16 positions over one frame plus ω × (lever ~15 mm): 1e-6 m/s.
+// Tolerances: ω from Q16 shear (≤ 2^-17 shear units per point) and nm positions: relative 2e-4;
+// t from Q16 positions over one frame plus ω × (lever ~15 mm): 1e-6 m/s.
 void expect_same_twist(const Vector6d& a, const Vector6d& b, const char* what) {
   EXPECT_LT((a.head<3>() - b.head<3>()).norm(), 2e-4 * b.head<3>().norm()) << what;
   EXPECT_LT((a.tail<3>() - b.tail<3>()).norm(), 1e-6) << what;

@@ -239,8 +239,9 @@ TEST(Fusion, SingleSensorWorksForBothMethodsAndIsFlagged) {
 // One pad alone: the joint fusion reads only the rotation about that pad's normal. A rotation
 // about an in-plane axis shears one flat pad like a translation; the noise-free scene here would
 // still let the 3x3 solve recover it from the indentation's heights, but on real frames those
-// sub-millimetre levers turn shear noise into rad/s (docs/dsp.md §7b), so the two in-plane
-// components are reported as exactly 0, rank 1, and the translation stays referred correctly.
+// sub-millimetre levers turn shear noise into rad/s (docs/dsp/solve-fusion-se3.md), so the two
+// in-plane components are reported as exactly 0, rank 1, and the translation stays referred
+// correctly.
 TEST(FusionJoint, OnePadReadsOnlyTheRotationAboutItsNormal) {
   const Eigen::Vector3d w(0.4, -0.3, 0.5), t(3e-3, -1e-3, 0.0);
   const Dual d = observe(w, t);

@@ -242,8 +242,7 @@ TEST(Motion, RotationFromRigidShearMatchesTruthAndReference) {
     // ≤ 0.5 nm position rounding per point and frame: ≤ 1 nm / dt = 1.2e-7 m/s.
     EXPECT_LT((m.translation - r.translation).norm(), 1.2e-7);
     // The point the translation applies at (the weighted centroid for kVelocity): same within
-    // the rounding of positions (0.5 nm) and heights (z goes through the Q16 filter; measured
-    // 4 nm).
+    // the rounding of positions (0.5 nm) and heights (z goes through the Q16 filter: a few nm).
     EXPECT_EQ(m.translation_source, static_cast<TranslationSource>(r.translation_source));
     EXPECT_LT((m.translation_point_m - r.translation_point).norm(), 1e-8);
   }
@@ -406,9 +405,9 @@ std::vector<dsp_ref::SensorMotionRef> reference_run(
 }
 
 // A held tangential load stretches the gel behind the patch, and 𝒢 reads the stretch as normal
-// load: Ω grows over gel that follows the object only partly (the simulator's sphere rx 4°
-// stick: 106 cells before the motion, 315 after). The displacement proxy reads its increments
-// over the patch as it was while the contact was tangentially unloaded (docs/dsp.md §4.2c).
+// load: Ω grows over gel that follows the object only partly. The displacement proxy reads its
+// increments over the patch as it was while the contact was tangentially unloaded
+// (docs/dsp/motion.md, patch anchor).
 // Here: an unloaded patch of radius 3 mm, then a torsion that grows Ω to 4.5 mm, the ring
 // gaining half the rigid increment. The anchored reading is the rigid torsion; over the whole
 // Ω_t ∩ Ω_{t−1} the ring would dilute it. Fixed path and double reference alike.
@@ -582,8 +581,8 @@ TEST(Motion, AContactThatLeftItsAnchoredCellsIsReadOverTheCellsItKept) {
 
 // A drag (the gel over the patch dragged along by a slide about an in-plane axis, or a
 // translation) stretches the gel behind the patch, 𝒢 reads the stretch as load and Ω leaves
-// the patch for gel whose shear has decayed (docs/dsp.md §4.2d: a no-cap sphere rx 30° read 14 %
-// too much at 0.5 s and 66 % at 3 s before). The velocity proxy then reads over Ω ∩ anchor.
+// the patch for gel whose shear has decayed, so a reading over Ω would depend on the slide's
+// speed (docs/dsp/motion.md, drag region). The velocity proxy then reads over Ω ∩ anchor.
 // Here: a grasp of radius 3 mm (anchored, no load), then Ω grown to 4.5 mm with the ring carrying
 // half the rigid velocity. A drag (ω about x) is read over the anchored cells, exactly; a
 // torsion (ω about z: no divergence, Ω is not displaced, and an elongated patch turns away from
@@ -772,13 +771,12 @@ TEST(Motion, LargeAreaChangeUsesCommonPointsInsteadOfTheCentroidJump) {
 
 TEST(Motion, AContactFormingAtACornerReadsTheMaterialPointsNotTheCentroidJump) {
   // A flat face is first seen at one corner (a few cells), and a frame later over most of its
-  // face: the mask's centroid jumps by millimetres while nothing moves (the simulator's textured
-  // cube: 4 cells, then 54, 101, 177; docs/dsp.md §4.1). The area-ratio bound (default 1.5)
-  // reads that frame from the material points in both masks; with the bound off (1e4) the
-  // sliding rule reports the jump as a translation of ~0.4 m/s. The face then shrinks (pressure
-  // released) by a cell-count ratio just under 1.5, which keeps the centroid rule; at a bound
-  // equal to that ratio still the centroid, just below it the material points. The double
-  // reference decides the same on every frame.
+  // face: the mask's centroid jumps by millimetres while nothing moves (docs/dsp/motion.md,
+  // translation). The area-ratio bound (default 1.5) reads that frame from the material points
+  // in both masks; with the bound off (1e4) the sliding rule reports the jump as a translation.
+  // The face then shrinks (pressure released) by a cell-count ratio just under 1.5, which keeps
+  // the centroid rule; at a bound equal to that ratio still the centroid, just below it the
+  // material points. The double reference decides the same on every frame.
   struct Chain {
     SensorMotion corner, face, smaller;
   };
@@ -806,8 +804,8 @@ TEST(Motion, AContactFormingAtACornerReadsTheMaterialPointsNotTheCentroidJump) {
       EXPECT_EQ(r.points, m.points);
       EXPECT_EQ(m.translation_source, static_cast<TranslationSource>(r.translation_source));
       // Positions are rounded to 0.5 nm and the heights that weight the centroid go through
-      // the Q16 filter: ≈ 4 nm per frame on a patch at rest (0.5 µm/s), ≈ 41 nm on the jump
-      // frame, where the weights themselves change (1e-5 of its 0.43 m/s).
+      // the Q16 filter: a few nm per frame on a patch at rest, and a small relative error on the
+      // jump frame, where the weights themselves change.
       EXPECT_LT((m.translation - r.translation).norm(), 1e-6 + 2e-5 * r.translation.norm());
       return m;
     };
@@ -845,13 +843,13 @@ TEST(Motion, AContactFormingAtACornerReadsTheMaterialPointsNotTheCentroidJump) {
 }
 
 TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
-  // A sliding patch whose mask advances in bursts, as Ω read from 𝒢 does in the simulator's
-  // 10 mm slides (a third of the cells enter or leave in one frame): the patch stands still for
-  // three frames, then jumps 1.5 mm. The gel does not move (w = 0: it slides). With the default
-  // calibration the per-frame centroid differences telescope, so their sum is the centroid's
-  // whole displacement (9 mm; the centroid weighted by the points' height, the sliding rule's).
-  // With the old gate at 0.3 every jump frame read the material points (zero in a slide) and
-  // the motion was lost (docs/accuracy.md item 5).
+  // A sliding patch whose mask advances in bursts, as Ω read from 𝒢 does in a slide (a third
+  // of the cells entering or leaving in one frame): the patch stands still for three frames,
+  // then jumps 1.5 mm. The gel does not move (w = 0: it slides). With the default calibration
+  // the per-frame centroid differences telescope, so their sum is the centroid's whole
+  // displacement (9 mm; the centroid weighted by the points' height, the sliding rule's). With
+  // a mask-change gate at 0.3 every jump frame reads the material points (zero in a slide) and
+  // the motion is lost, which is why the gate is off by default.
   for (bool gated : {false, true}) {
     Calibration cal;  // the default gate (off) unless `gated`
     cal.velocity_proxy = VelocityProxy::kVelocity;
@@ -901,9 +899,9 @@ TEST(Motion, SlidingTranslationTelescopesThroughMaskBursts) {
 TEST(Motion, SlidingCentroidIsWeightedByHeightSoAHysteresisTrailHardlyMovesIt) {
   // A patch slides 6 mm along x in one step (kVelocity, sliding rule). Where it was, f^z stays
   // at 1.5 τ_off: above the threshold that keeps last frame's cells in Ω, below the one that
-  // admits new cells, the trail the simulator's slides leave (docs/accuracy.md item 5). Those
-  // cells stay in Ω, at a small height. The plain mask centroid is pulled back by them; the
-  // height-weighted one, which the sliding rule reads, much less.
+  // admits new cells, the trail a slide leaves behind. Those cells stay in Ω, at a small
+  // height. The plain mask centroid is pulled back by them; the height-weighted one, which the
+  // sliding rule reads, much less.
   Calibration cal;
   cal.velocity_proxy = VelocityProxy::kVelocity;
   // The one-frame 6 mm step with its trail doubles Ω's area, which the area-ratio bound would

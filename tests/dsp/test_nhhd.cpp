@@ -99,7 +99,7 @@ TEST(Nhhd, LocalRotationGivesROnly) {
   // A Gaussian vortex (object twisting on a contact patch): its curl lies inside the grid and it
   // has no divergence, so the natural HHD is r = w, d = 0, k = 0 up to the O(h^2 / s^2)
   // discretisation of the sampled field (central differences of a sampled vortex are not exactly
-  // divergence-free). Measured: |d| = 0.13 %, |k| = 0.5 % of |w|.
+  // divergence-free).
   auto n = make_nhhd(converging_config());
   const GridVectorD wd = f::sample(f::gaussian_vortex(0.8, 4.0, 1.5, -1.0));
   const VectorField w = dsp_ref::grid_vector_to_q16(wd);
@@ -152,7 +152,7 @@ TEST(Nhhd, RigidRotationIsRotationalWithTheNaturalHarmonicPart) {
   EXPECT_GT(rel(r, wd), 0.9);
   EXPECT_LT(rel(k, wd), 0.25);
   EXPECT_GT(rel(k, wd), 0.1);
-  // Whole-grid sources are the worst case for the truncated multipole ring: 1.2 % measured.
+  // Whole-grid sources are the worst case for the truncated multipole ring.
   EXPECT_LT(f::rms_diff(r, gr) / f::rms(wd), 0.02);
   EXPECT_LT(f::rms_diff(k, gk) / f::rms(wd), 0.02);
 }
@@ -200,7 +200,7 @@ TEST(Nhhd, CurlOfDAndDivergenceOfRVanishExactly) {
 TEST(Nhhd, HarmonicPartIsDivergenceAndCurlFreeAtConvergence) {
   // At convergence lap5(phi) = div w, while div d is the wide-stencil Laplacian of phi; the two
   // differ by O(h^2 d^4 phi), so div k and curl k are small compared with div w and curl w (not
-  // exactly 0 on this collocated grid). Measured ratios: 3-7 % for sources 2.5 cells wide.
+  // exactly 0 on this collocated grid).
   auto n = make_nhhd(converging_config());
   f::Rng rng(5);
   const GridVectorD wd = f::random_smooth(rng, 3.0);
@@ -226,9 +226,9 @@ TEST(Nhhd, HarmonicPartIsDivergenceAndCurlFreeAtConvergence) {
 TEST(Nhhd, AgreesWithFreeSpaceGreensFunctionDecomposition) {
   // Fields whose sources lie inside the grid (vortices/sources > 3 sigma from the edges) plus a
   // uniform shear (no sources). The converged padded-domain solution must match the free-space
-  // decomposition phi = G * div w, psi = G * curl w. Measured: 0.2-0.4 % of |w| (discretisation of
-  // the 5-point Laplacian vs the exact kernel, plus the truncated multipole ring); bound 1 %.
-  // With a Dirichlet-0 ring on the same small padding the error is ~10x larger.
+  // decomposition phi = G * div w, psi = G * curl w, up to the discretisation of the 5-point
+  // Laplacian vs the exact kernel and the truncated multipole ring; bound 1 %. A Dirichlet-0
+  // ring on the same small padding would miss the far field and not meet it.
   const GridVectorD wd = f::add(f::add(f::sample(f::gaussian_vortex(0.9, 3.0, -6.0, 2.0)),
                                        f::sample(f::gaussian_source(1.2, 3.5, 5.0, -1.5))),
                                 f::sample(f::uniform(0.5, -0.3)));
@@ -264,9 +264,9 @@ TEST(Nhhd, AgreesWithFreeSpaceGreensFunctionDecomposition) {
 TEST(Nhhd, FixedPointMatchesDoubleReferenceOfTheSameScheme) {
   // Same config, same sequence of calls (warm start included): the only difference is integer
   // rounding (Q12 potentials, round-half-up in every sweep) and the Q16 quantisation of the
-  // input. Thresholds from the error budget in docs/dsp.md: each sweep adds <= 0.5 Q12 LSB per
-  // point, the multigrid cycle is contractive, and d = 8 (phi[+1] - phi[-1]) maps 1 Q12 LSB of
-  // potential error to 8-16 Q16 LSB. Measured ~75-80 dB and <= ~60 LSB.
+  // input. Thresholds from the error budget in docs/dsp/fields.md: each sweep adds <= 0.5 Q12
+  // LSB per point, the multigrid cycle is contractive, and d = 8 (phi[+1] - phi[-1]) maps 1 Q12
+  // LSB of potential error to 8-16 Q16 LSB.
   const NhhdConfig config;  // defaults
   auto n = make_nhhd(config);
   dsp_ref::NhhdRef ref(config);

@@ -143,10 +143,7 @@ double rms_omega_difference(const std::vector<Vector6d>& a, const std::vector<Ve
   return std::sqrt(sum / static_cast<double>(a.size()));
 }
 
-// Fixed point vs the double reference, end to end (twist every frame, final pose).
-// Measured on x86-64 (worst case over the four cases): final angle 0.09° apart on a 30° estimate
-// (0.3 %), ω SNR ≥ 39 dB wherever the estimate is more than half a degree, RMS ω difference
-// 0.014 rad/s on the drift-only translation case, positions 27 µm apart in velocity mode. The
+// Fixed point vs the double reference, end to end (twist every frame, final pose). The
 // position and drift differences come from single grid cells on the τ threshold of Ω that one
 // implementation keeps and the other drops (the mask is a hard decision), which moves the
 // contact centroid by a fraction of a cell. The bounds leave about 2-3x margin for aarch64,
@@ -216,9 +213,8 @@ INSTANTIATE_TEST_SUITE_P(
 // Against the scene's truth, with the kinematic (displacement) proxy and the joint fusion, which
 // need no calibration while the contact sticks. The estimate reads the gel through 16x16 px
 // flow windows and a σ = 8 px smoothing, and Ω reaches a little beyond the sticking patch where
-// the gel has already relaxed, so the magnitudes come out 10-30 % low (measured: rz 92 %,
-// rx 74 %, ty 77 %); the per-axis calibration scales absorb that. What must hold exactly is
-// the direction, the sign and the separation of the axes.
+// the gel has already relaxed, so the magnitudes come out low; the per-axis calibration scales
+// absorb that. What must hold exactly is the direction, the sign and the separation of the axes.
 TEST(PipelineTruth, RotationAboutNormalAxis) {
   const Rendered& r = rotation_about_z();
   const RunResult fx = run_fixed(r, dual_config(r.scene, FusionMethod::kJoint),

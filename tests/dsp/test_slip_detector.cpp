@@ -278,9 +278,8 @@ TEST(SlipDetector, StickRampAndHoldStaysStuckAndEqualsTheDisplacementProxy) {
 // A stuck contact whose Ω loses its rim for a while (on small or deeply pressed objects the rim
 // cells flicker out of Ω, and during the grasp Ω can collapse for a few frames). The rigid
 // content X over Ω then drops by a third although no cell's shear changed; read as a relaxation
-// it started a slip, and the velocity proxy then integrated the held shear (2-3° stick motions
-// read as 19-34° on the simulator, docs/accuracy.md item 8). The detector reads dX from the
-// increments over Ω_t ∩ Ω_{t−1}.
+// it would start a slip, whose payback adds the velocity proxy's reading of the held shear, many
+// times the motion. The detector reads dX from the increments over Ω_t ∩ Ω_{t−1}.
 TEST(SlipDetector, AStuckContactLosingItsRimStaysStuck) {
   std::vector<double> theta;
   for (int k = 0; k < 24; ++k) theta.push_back(0.0);
@@ -559,7 +558,7 @@ TEST(SlipDetector, NoSlipOnsetWhileTheLoadFallsFasterThanTheReleaseRate) {
   EXPECT_EQ(mr.omega, Eigen::Vector3d::Zero());
 }
 
-// The displacement proxy's patch anchor is set again where a slide ended (docs/dsp.md §4.2c):
+// The displacement proxy's patch anchor is set again where a slide ended (docs/dsp/motion.md):
 // the patch is where the slide left it, and the friction-held shear left in the gel is no
 // reason to keep the patch of before the slide. Here the grasp is a small disc (anchored, no
 // load), which grows into a large one once a 10 mm slide loads it (the anchor stays on the
@@ -604,7 +603,7 @@ TEST(SlipDetector, ASlideEndsWithThePatchItLeftAnchored) {
     ASSERT_EQ(r.slipping, m.slipping) << "frame " << k;
     ASSERT_EQ(r.anchor_set, m.anchor_set) << "frame " << k;
     // While slipping the velocity proxy reads the drag over Ω ∩ anchor (the small disc), as
-    // long as Ω holds it (docs/dsp.md §4.2d).
+    // long as Ω holds it (docs/dsp/motion.md, drag region).
     ASSERT_EQ(r.velocity_anchored, m.velocity_anchored) << "frame " << k;
     ASSERT_EQ(static_cast<int>(r.samples.size()), m.moments.n) << "frame " << k;
     if (m.slipping) {

@@ -133,8 +133,8 @@ TEST(Smoothing, MatchesDoubleReference) {
   // Same normalised convolution in double with exact taps. Error sources: Q15 tap rounding
   // (<= 0.5 LSB per tap, i.e. a relative weight error <= 2^-16 / g_min) and the final rounding
   // (0.5 LSB). Worst case: |tap error| summed over the 2-D kernel ~ 4e-4 times the field variation
-  // under the kernel (~1 px here) ~ 24 LSB; the errors average out, measured <= 2.2 LSB and
-  // >= 100 dB. Thresholds 90 dB SNR and 8 LSB.
+  // under the kernel (~1 px here) ~ 24 LSB; the errors average out. Thresholds 90 dB SNR and
+  // 8 LSB.
   for (int seed = 1; seed <= 4; ++seed) {
     f::Rng rng(static_cast<std::uint64_t>(seed));
     const GridVectorD wd0 = f::random_smooth(rng, 3.0, 0.2);
@@ -238,7 +238,7 @@ TEST(Smoothing, ExtremeInputsDoNotOverflow) {
   // Full-scale checkerboard, with and without holes: the exact normalised means (double
   // reference) are reproduced within the tap-rounding bound, never wrapped. Bound: the Q15 taps
   // are off by <= 0.5 LSB each and the centre tap by <= R LSB, so the 2-D weights are off by
-  // <= 2 * 6 / 2^15 in total, times the input range 2^16 px: 24 px (measured 1.5 px).
+  // <= 2 * 6 / 2^15 in total, times the input range 2^16 px: 24 px.
   f::Rng rng(8);
   const GridMaskD holes = f::random_mask(rng, 0.3);
   const GridVectorD wd = dsp_ref::grid_vector_from_q16(w);

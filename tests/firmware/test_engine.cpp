@@ -335,8 +335,8 @@ TEST_F(EngineTest, BothSensorsLostIsAFault) {
 
 // The two pads of one board go a few ms apart (a sysfs unbind removes them one after the other)
 // with no cycle in between, here after the stream has already stopped for two frame periods and
-// the last cycle's slot went to the 10 Hz group: before, neither change went out until the next
-// group (up to 100 ms). With no cycle running, one change Status per frame period.
+// the last cycle's slot went to the 10 Hz group: holding either change for the next group would
+// delay it by up to 100 ms. With no cycle running, one change Status per frame period.
 TEST_F(EngineTest, SecondSensorLostWithoutACycleBetweenIsReportedAtOnce) {
   // 13 ticks: the last one (at 100.5 ms) carries the periodic group, the next is due at 200 ms.
   for (std::size_t i = 0; i < 13; ++i) tick(i);
@@ -358,8 +358,8 @@ TEST_F(EngineTest, SecondSensorLostWithoutACycleBetweenIsReportedAtOnce) {
 }
 
 // The case of the VM's sysfs unbind: the first pad's loss goes out in the last cycle's own slot
-// (no periodic group in it), then the second pad goes 3 ms later with no cycle after it. Before,
-// that FAULT waited for the 10 Hz group (up to 100 ms, 105 ms measured under TCG).
+// (no periodic group in it), then the second pad goes 3 ms later with no cycle after it. Held
+// for the 10 Hz group, that FAULT would wait up to 100 ms.
 TEST_F(EngineTest, FaultAfterADegradedStatusInTheLastCyclesSlotIsNotHeld) {
   // 14 ticks: the group went out with tick 12 (at 100.5 ms), tick 13 (108.8 ms) has its slot free.
   for (std::size_t i = 0; i < 14; ++i) tick(i);

@@ -158,8 +158,8 @@ TEST(SimPhysics, StickTranslationFollowsSurfaceKinematicsExactly) {
 // since the motion started, bulge and all (docs/simulator.md §6). For a torsion of a centred
 // sphere the bulge is radial and does not change, so the material now at c came from R⁻¹c and
 // was displaced there by U_n(R⁻¹c) = R⁻¹U_n(c): U(c) = c − R⁻¹c + R⁻¹U_n(c). The plain sum
-// U_t + U_n leaves the bulge vector unturned (off by θ|U_n|, 15 µm here), which made the image's
-// patch turn faster than the object (a raw-flow torsion of 4.57° for 4°). In a translation the
+// U_t + U_n leaves the bulge vector unturned (off by θ|U_n|, 15 µm here), which would make the
+// image's patch turn faster than the object. In a translation the
 // bulge moves with the object: U(c) = t + U_n(c), the plain sum (sampling the moved bulge where
 // the material came from would shift it twice, by t·∇U_n: 41 µm here).
 TEST(SimPhysics, AStuckObjectCarriesTheBulgedGelWithIt) {
@@ -282,7 +282,8 @@ TEST(SimPhysics, AReleasedStuckContactLetsItsBondedGelGoSmoothly) {
   std::printf("release: the bond's largest per-frame change %.1f um, at contact loss %.1f um\n",
               worst_step * 1e3, worst_at_loss * 1e3);
   EXPECT_FALSE(had_contact);
-  // Measured 28.7 and 2.0 µm; with the full grasp bulge held to the end, 128.7 and 124.5 µm.
+  // A bond that held the full grasp bulge to the end would jump by about that bulge at the
+  // contact's loss, far beyond both bounds.
   EXPECT_LT(worst_at_loss, 10e-3);
   EXPECT_LT(worst_step, 60e-3);
 }

@@ -208,9 +208,9 @@ TEST(Accuracy, CalibratedPipelineTracksShortSimulatedGrasps) {
         << ch.c.label() << " auto";
     ASSERT_TRUE(res[1].slip_scored) << ch.c.label();
     // The fixed-point arithmetic against the double reference taking the same discrete
-    // decisions: the 0.2 deg bound. The free-running figure is printed, not bounded: a
-    // threshold crossing on one side only (a point tracked, a slip onset) can part the two by
-    // degrees (docs/accuracy.md, item 7).
+    // decisions: a 0.2 deg bound. The free-running figure is printed, not bounded: a threshold
+    // crossing on one side only (a point tracked, a slip onset) can part the two by degrees
+    // (docs/dsp/reference.md).
     ASSERT_TRUE(res[1].fixed_vs_locked_reference_deg && res[1].fixed_vs_reference_deg);
     std::printf("%-16s auto         fixed-ref %.3f deg free-running, %.3f deg same decisions\n",
                 ch.c.label().c_str(), *res[1].fixed_vs_reference_deg,
@@ -230,9 +230,9 @@ TEST(Accuracy, CalibratedPipelineTracksShortSimulatedGrasps) {
 
 // A pad that disappears for a few frames of a dual grasp (a camera hiccup; on a small object its
 // contact mask can also flicker out at the rim) leaves the fused estimate to the other pad. The
-// joint fusion then reads only the rotation about that pad's normal (docs/dsp.md §7b): the
-// in-plane components would rest on the indentation's sub-millimetre heights alone, where the
-// shear noise of a pad at rest became rad/s and turned the object by degrees per dropout.
+// joint fusion then reads only the rotation about that pad's normal (docs/dsp/solve-fusion-se3.md):
+// the in-plane components would rest on the indentation's sub-millimetre heights alone, where
+// the shear noise of a pad at rest would become rad/s and turn the object by degrees per dropout.
 TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
@@ -259,11 +259,11 @@ TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
   EXPECT_LT(r.apart_deg, 0.3);
 }
 
-// Stick grasps on the objects where the detector used to call a slip: a small sphere, a sphere
-// pressed 1.5 mm deep, the fluted screwdriver handle. There Ω's rim flickers (or collapses for a
-// few frames of the grasp), and the rigid content of the shear over Ω dropped with no slide; the
-// velocity proxy then integrated the held shear (21-34 deg for 2-3 deg, docs/accuracy.md). With the
-// committed calibration and the default --mode auto, as a user would replay them.
+// Stick grasps on objects where a false slip is easy to call: a small sphere, a sphere pressed
+// 1.5 mm deep, the fluted screwdriver handle. There Ω's rim flickers (or collapses for a few
+// frames of the grasp), and the rigid content of the shear over Ω drops with no slide; a false
+// slip would pay back the velocity proxy's reading of the held shear, many times the motion.
+// With the committed calibration and the default --mode auto, as a user would replay them.
 TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
@@ -292,18 +292,17 @@ TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
 }
 
 // A translation starts off the pad's centre (tacse3-sim places the object at −magnitude/2), so
-// the grasp forms there. While the mask grows, its weighted centroid moves by a fifth of a
-// millimetre with nothing moving. Two rules keep that out of the estimate (docs/accuracy.md
-// item 5):
+// the grasp forms there. While the mask grows, its weighted centroid moves with nothing moving.
+// Two rules keep that out of the estimate:
 //  - the area-ratio bound (max_mask_area_ratio, 1.5): the frames where the mask grows by more
 //    than half read the material points, so the velocity reading hardly moves in the grasp;
-//  - the unloaded-stick rule: `auto` reads the grasp from the material points, but used to pay
-//    the velocity reading back from the contact's first frame at the slide's onset, as no stick
-//    was confirmed before the slide (stick_confirm_s is 1 s, the grasp and settle 0.5 s). An
-//    unloaded contact at rest is now confirmed stuck after slip_on_frames frames, which drops
-//    that reading. With the area bound switched off the velocity reading drifts again, and this
-//    rule alone must keep `auto` clear of it. (On this sphere `auto` ends the same with the bound
-//    on or off; the bound's own effect on `auto` is the next test's.)
+//  - the unloaded-stick rule: `auto` reads the grasp from the material points, and would pay
+//    the velocity reading back from the contact's first frame at the slide's onset if no stick
+//    were confirmed before the slide (stick_confirm_s is 1 s, the grasp and settle 0.5 s). An
+//    unloaded contact at rest is confirmed stuck after slip_on_frames frames, which drops that
+//    reading. With the area bound switched off the velocity reading drifts in the grasp, and
+//    this rule alone must keep `auto` clear of it. (The bound's own effect on `auto` is
+//    AFlatFaceFirstSeenAtACornerIsNotReadAsATranslation's.)
 TEST(Accuracy, TheGraspOfAnOffCentreContactIsNotPaidBackAsASlide) {
   const tacse3::config::CalibrationSet committed = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
@@ -350,7 +349,7 @@ TEST(Accuracy, TheGraspOfAnOffCentreContactIsNotPaidBackAsASlide) {
         // The case still shows the grasp's centroid motion, or it would test nothing.
         EXPECT_GT(grasp_drift_mm, 0.1) << axis;
         // auto pays the slide back but not the grasp, so it ends clearly closer to the truth
-        // than the velocity reading; paying the grasp back, it ended where velocity did.
+        // than the velocity reading; paying the grasp back, it would end where velocity does.
         EXPECT_LT(e.final_translation_error_mm, ev.final_translation_error_mm - 0.05) << axis;
       }
       // The translation goal of docs/accuracy.md.
@@ -361,18 +360,17 @@ TEST(Accuracy, TheGraspOfAnOffCentreContactIsNotPaidBackAsASlide) {
 
 // The block flow on the simulator's pressed, shaded, noisy gel: the pattern at the patch is
 // strained (the bulge, the shear) and shaded, so a correct match leaves more residual than on a
-// shifted frame. With the old residual bound (0.15 of the template energy) 12 % of the grid was
-// untracked at rest after the grasp and 18 % at the torsion's peak, all around and inside the
-// patch; the smoothed field, 𝒢 and the mask then leaned away from them (docs/accuracy.md item 9).
+// shifted frame. A tight residual bound (0.15 of the template energy) leaves points around and
+// inside the patch untracked, and the smoothed field, 𝒢 and the mask lean away from them.
 TEST(Accuracy, TheFlowTracksThePressedGelEverywhere) {
   const tt::SimCase c = sim_case("sphere", "rz", 30, 1, 0);
   std::string err;
   const auto src = open_sim(c, &err);
   ASSERT_TRUE(src) << err;
   const tt::SourceInfo& info = src->info();
-  // Per pad, the default flow and beside it one with the old bound (0.15, with today's
-  // consensus rule). The old bound must still lose points here: otherwise the simulator no
-  // longer strains the gel enough for this test to show anything.
+  // Per pad, the default flow and beside it one with the tight bound (0.15). The tight bound
+  // must lose points here: otherwise the simulator does not strain the gel enough for this test
+  // to show anything.
   tacse3::dsp::BlockFlowConfig old_bound;
   old_bound.max_residual_ratio = 0.15;
   constexpr int kPads = 2;
@@ -417,13 +415,12 @@ TEST(Accuracy, TheFlowTracksThePressedGelEverywhere) {
 }
 
 // The area bound's own effect on `auto` (the sphere above is handled by the unloaded-stick rule
-// as well): the textured cube's flat face is first seen at one corner (4 cells, then 54, 101,
-// 177), the velocity reading jumps by (6.4, -6.4) mm in the grasp, and its grasp is loaded
-// (28 µm of planar shear content), so no stick is confirmed before the slide and `auto` paid
-// the jump back: 9.45 mm off for 10 mm with the bound off, 0.40 mm with it. That content sits
-// close to slip_min_shift_m (20 µm): with the refit of docs/accuracy.md item 13 it reads
-// under it, the unloaded-stick rule covers this grasp too and both variants end 0.88 mm off.
-// The test pins the minimum shift at 10 µm so that the bound alone is what it measures.
+// as well): the textured cube's flat face is first seen at one corner, so its mask grows many
+// times over in the grasp and the velocity reading jumps by millimetres; the grasp is loaded,
+// so no stick is confirmed before the slide and without the bound `auto` would pay the jump
+// back. The grasp's planar shear content sits close to slip_min_shift_m, where the
+// unloaded-stick rule may cover it too: the test pins the minimum shift at 10 µm so that the
+// bound alone is what it measures.
 TEST(Accuracy, AFlatFaceFirstSeenAtACornerIsNotReadAsATranslation) {
   tacse3::config::CalibrationSet committed = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
@@ -440,14 +437,13 @@ TEST(Accuracy, AFlatFaceFirstSeenAtACornerIsNotReadAsATranslation) {
   EXPECT_GT(off_e.final_translation_error_mm, 5.0);
 }
 
-// 10 mm slides where the block flow's chain used to take a wrong match while the gel sprang back
-// behind the patch, and kept it for good: at a keyframe switch the direct match against the tare
-// was valid but disagreed with the chain by more than the old 0.5 px re-anchoring tolerance, so
-// the wrong chain was kept. The gel left at rest read as deformed, f^z stayed above the contact
-// threshold there and a phantom contact (up to 176 cells) held the weighted centroid back:
-// 3.80 mm (screwdriver handle) and 2.17 mm (sphere pressed 2 mm) off for 10 mm. Every valid
-// direct match now replaces the chain (docs/dsp.md, stage 2, re-anchoring). Defaults, committed
-// calibration, as a user would replay them.
+// 10 mm slides where the block flow's chain can take a wrong match while the gel springs back
+// behind the patch: at a keyframe switch the direct match against the tare is valid but
+// disagrees with the chain by more than a tight re-anchoring tolerance accepts. A wrong chain,
+// kept, makes the gel left at rest read as deformed, f^z stays above the contact threshold
+// there and a phantom contact holds the weighted centroid back. Every valid direct match
+// replaces the chain (docs/dsp/flow.md, re-anchoring). Defaults, committed calibration, as a
+// user would replay them.
 TEST(Accuracy, AChainThatTookAWrongMatchIsReanchoredToTheTare) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
@@ -464,12 +460,11 @@ TEST(Accuracy, AChainThatTookAWrongMatchIsReanchoredToTheTare) {
 
 // A grasp released at the end: after the hold the pads open over 0.3 s and the contact vanishes;
 // the object stays where the motion left it. The stuck gel springs back as it is let go, which
-// the displacement proxy read as the object moving back (sphere rx 2°: 1.43° off at the end,
-// most of the motion undone; ty 0.5 mm: 0.36 mm), and its relaxation started a slip whose
-// payback added the velocity proxy's reading of the held shear (31° off). The detector now
-// counts only relaxation beyond the load's own fall, and frames whose load Σ z falls faster
-// than release_load_rate drop the displacement reading (docs/dsp.md §4.2b). Defaults, committed
-// calibration.
+// the displacement proxy would read as the object moving back, and its relaxation would start a
+// slip whose payback adds the velocity proxy's reading of the held shear. The detector counts
+// only relaxation beyond the load's own fall, and frames whose load Σ z falls faster than
+// release_load_rate drop the displacement reading (docs/dsp/motion.md, release). Defaults,
+// committed calibration.
 TEST(Accuracy, AReleasedGraspKeepsThePoseItHeld) {
   const tacse3::config::CalibrationSet committed = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
@@ -497,8 +492,8 @@ TEST(Accuracy, AReleasedGraspKeepsThePoseItHeld) {
 // max_frame_gap_s, while the frames continue where they were, so only the one increment across
 // it is not read) restarts the motion differencing, but the gel is still stretched by the
 // tangential load: the displacement proxy keeps reading over the patch anchored before the
-// load (docs/dsp.md §4.2c). When the restart re-anchored to the stretched Ω, sphere rx 4° read
-// 3.29° at the end, 0.71° off (the motion after the gap at about 0.6 of its size).
+// load (docs/dsp/motion.md, patch anchor). Re-anchored to the stretched Ω, the increments after
+// the gap would be diluted and the motion would read short.
 TEST(Accuracy, AFrameGapDuringAStickMotionKeepsThePatchAnchor) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
@@ -522,9 +517,9 @@ TEST(Accuracy, AFrameGapDuringAStickMotionKeepsThePatchAnchor) {
 }
 
 // Every axis a recording turns about is fitted for the proxy that explains it, from 1 deg of
-// rotation (tacse3-calibrate, docs/calibration.md stage 2; tested with a 2 deg stick). With a 3 deg floor the only
-// stick recording about y (2 deg) left the displacement proxy's y scale to the velocity proxy's
-// fit on the slide (the report's note says so), and a stick about y read over.
+// rotation (tacse3-calibrate, docs/calibration.md stage 2). A higher floor would skip the only
+// stick recording about y (2 deg) and leave the displacement proxy's y scale to the velocity
+// proxy's fit on the slide (the report's note would say so), and a stick about y would read over.
 TEST(Accuracy, ATwoDegreeStickRotationFitsItsAxisForTheDisplacementProxy) {
   const std::vector<tt::SimCase> cal = {short_case("sphere", "ry", 30, 7, 18),
                                         short_case("sphere", "rx", 3, 7, 18),
@@ -546,20 +541,18 @@ TEST(Accuracy, ATwoDegreeStickRotationFitsItsAxisForTheDisplacementProxy) {
   const tt::PoseErrors ry = replay_errors(short_case("sphere", "ry", 2, 1, 20), rep.calibration);
   std::printf("sphere ry 2 deg (seed 1, radius 20 mm): %.2f deg, error %.2f deg\n",
               ry.estimated_rotation_deg, ry.final_rotation_error_deg);
-  // 0.05 deg measured. With the 3 deg floor the note above fails the test; the reading itself
-  // was 0.12 deg then, and is 0.01 deg since the displacement proxy reads the anchored patch
-  // (docs/dsp.md §4.2c), so this bound alone no longer tells the two floors apart.
+  // With a higher floor the note check above fails. The displacement proxy reads the anchored
+  // patch (docs/dsp/motion.md), so even a borrowed y scale reads this stick closely: this bound
+  // alone does not tell the floors apart.
   EXPECT_LT(ry.final_rotation_error_deg, 0.10);
 }
 
 // The velocity proxy reads a slide about an in-plane axis at any speed with the same gain
-// (docs/dsp.md §4.2d). Without the friction cap (--friction 5: the gel's shear is c·v at every
-// speed but on a thin rim of the patch, and its integral over the motion is c times the angle),
-// the same 30° about x in 0.5 s and in 2 s must read the same. Before the velocity proxy read a
-// drag over the anchored patch, Ω left the patch for the stretched gel behind it the more the
-// faster the slide, and the two read 34.1° and 46.1° (0.74 apart, uncalibrated for this
-// friction); measured since: 61.40° and 61.41° with stop 19's calibration, 41.07° and 41.00°
-// with the refit of accuracy.md item 16.
+// (docs/dsp/motion.md, drag region). Without the friction cap (--friction 5: the gel's shear is
+// c·v at every speed but on a thin rim of the patch, and its integral over the motion is c times
+// the angle), the same 30° about x in 0.5 s and in 2 s must read the same. Read over all of Ω,
+// the faster slide would read less: Ω leaves the patch for the stretched gel behind it the more
+// the faster the slide.
 TEST(Accuracy, TheVelocityProxyReadsAnInPlaneSlideAtAnySpeed) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   double read[2] = {0.0, 0.0};
@@ -579,11 +572,10 @@ TEST(Accuracy, TheVelocityProxyReadsAnInPlaneSlideAtAnySpeed) {
 }
 
 // Without the friction cap the pipeline reads an in-plane rotation with one gain at any angle,
-// so the benchmark's 60° and 90° shortfall is the cap's (docs/accuracy.md item 2 (e)): the same
-// sphere turned 30° (in 1 s) and 90° (in 2 s, 1.5 times the peak speed) about x with
-// --friction 5, defaults (joint, auto), must read the same per degree. Measured 41.11° and
-// 123.57° with the committed calibration (fitted with the cap, hence above the angle): per
-// degree 1.370 and 1.373. With the preset friction the two read 30.73° and 69.08°.
+// so the benchmark's 60° and 90° shortfall is the cap's (docs/accuracy.md): the same sphere
+// turned 30° (in 1 s) and 90° (in 2 s, 1.5 times the peak speed) about x with --friction 5,
+// defaults (joint, auto), must read the same per degree. The committed calibration was fitted
+// with the cap, so without it both read above the angle; only their ratio is bounded.
 TEST(Accuracy, WithoutTheFrictionCapThirtyAndNinetyDegreesReadWithOneGain) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   double per_degree[2] = {0.0, 0.0};

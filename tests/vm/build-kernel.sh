@@ -24,7 +24,7 @@ if [ ! -f "$OUT/.done" ]; then
   cp "$tree/boot/vmlinuz-$KREL" "$OUT/vmlinuz"
   cp "$tree/boot/config-$KREL" "$OUT/config"
   if [ "$ARCH" = x86_64 ]; then
-    # Decompressing the xz bzImage takes ~11 s under TCG. The kernel has CONFIG_PVH, so qemu can
+    # Decompressing the xz bzImage is slow under TCG. The kernel has CONFIG_PVH, so qemu can
     # start the uncompressed ELF vmlinux directly (PVH entry): unpack it once here.
     python3 - "$OUT/vmlinuz" "$OUT/vmlinux" <<'PY'
 import lzma, sys

@@ -130,9 +130,10 @@ TEST(SimCamera, StateErrorsAndInfo) {
 // Both capture threads paced to the wall clock: the median arrival period is the frame period.
 TEST(SimCamera, PacedToTheFrameRate) {
   if (kEmulated) GTEST_SKIP() << "wall-clock pacing bounds only hold natively";
-    // 10 fps by default (4 in the sanitizer build, whose render costs ~20 ms CPU): low enough for
-    // a loaded 2-core machine to render both pads in time; the pacing logic is the same at any
-    // rate. TACSE3_TEST_SIM_FPS=120 measures the sensor rate (docs/hal.md quotes such runs).
+    // 10 fps by default (4 in the sanitizer build, whose render is several times slower): low
+    // enough for a loaded 2-core machine to render both pads in time; the pacing logic is the
+    // same at any rate. TACSE3_TEST_SIM_FPS=120 measures the sensor rate (docs/hal-camera.md
+    // quotes such runs).
 #if defined(__SANITIZE_ADDRESS__)
   constexpr int kDefaultFps = 4;
 #else
