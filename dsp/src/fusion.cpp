@@ -29,7 +29,7 @@ void fuse_paper(const std::array<const SensorMotion*, 2>& s, const FusionConfig&
                 FusedMotion& out) noexcept {
   const Eigen::Vector3d sw(cfg.sign[0], cfg.sign[1], cfg.sign[2]);
   const Eigen::Vector3d st(cfg.sign[3], cfg.sign[4], cfg.sign[5]);
-  // ξ₁ as is, ξ₂ through the sign matrix S (Sec. V-C), then the mean of whoever contributed:
+  // ξ₁ as is, ξ₂ through the sign matrix S (Sec. V-B), then the mean of whoever contributed:
   // ½(ξ₁ + Sξ₂) with both, the single sensor's (signed) estimate otherwise.
   Eigen::Vector3d w = Eigen::Vector3d::Zero();
   Eigen::Vector3d t = Eigen::Vector3d::Zero();

@@ -229,7 +229,7 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
     out.slipping[i] = r.slipping;
   }
 
-  // Fusion (Sec. V-C) in G; an absent sensor gives the flagged single-sensor mode.
+  // Fusion (Sec. V-B) in G; an absent sensor gives the flagged single-sensor mode.
   (void)fuse(motions[0], motions[1], config_.fusion, config_.finger_separation_m, out.fused);
   out.valid = out.fused.valid;
   out.single_sensor = out.fused.single_sensor;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 tests: dual-sensor fusion, paper method and joint method: the Sec. V-C cases (mirrored
+// tacse3 tests: dual-sensor fusion, paper method and joint method: the Sec. V-B cases (mirrored
 // sensors: a translation cancels in the rotation, rotations about x/y/z add up with the right
 // signs), single-sensor operation, bad inputs.
 #include <gtest/gtest.h>

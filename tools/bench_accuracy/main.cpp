@@ -369,7 +369,7 @@ int main(int argc, char** argv) {
       "switches with their re-anchored and lost points, the contact mask and the stick/slip "
       "decision) and computes the rest in double, "
       "i.e. the fixed-point arithmetic's difference apart from a few per-point choices the "
-      "reference still makes itself (docs/dsp.md). The free-running figure adds the threshold "
+      "reference still makes itself (docs/dsp/reference.md). The free-running figure adds the threshold "
       "crossings where the two arithmetics decide differently.");
   add("");
   add("### Table V-B: grasped sphere, mean angular error (deg)");

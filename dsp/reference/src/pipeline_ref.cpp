@@ -202,7 +202,7 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
         t.z() = 0.0;
       }
     } else {
-      // Paper Sec. V-C: ξ = ½(ξ₁ + S ξ₂), then R_GS of sensor 1.
+      // Paper Sec. V-B: ξ = ½(ξ₁ + S ξ₂), then R_GS of sensor 1.
       int nw = 0, nt = 0;
       for (int i = 0; i < 2; ++i) {
         const auto& s = m[static_cast<std::size_t>(i)];

@@ -14,7 +14,7 @@
 namespace tacse3::dsp {
 
 enum class FusionMethod : std::uint8_t {
-  // Paper Sec. V-C: ξ = ½(ξ₁ + S ξ₂) of the per-sensor own-frame twists, then rotated into G with
+  // Paper Sec. V-B: ξ = ½(ξ₁ + S ξ₂) of the per-sensor own-frame twists, then rotated into G with
   // sensor 1's R_GS. The lever arm to the object is absorbed by the per-axis calibrated scales.
   kPaper = 0,
   // Both sensors' moments mapped into G with the extrinsics and the current finger separation,

@@ -47,7 +47,7 @@ struct ObjectSpec {
 };
 
 // Named presets: the six shapes ("sphere", "ellipsoid", "cylinder", "cube", "bumpy",
-// "screwdriver") and the paper's eight objects of Sec. V-D ("large-sphere", "ellipsoid",
+// "screwdriver") and the paper's eight objects of Sec. V-C ("large-sphere", "ellipsoid",
 // "irregular", "cylinder", "plastic-cube", "wooden-cube", "textured-cube", "screwdriver").
 bool object_preset(std::string_view name, ObjectSpec* out) noexcept;
 // Comma-separated list of the preset names, for help texts.
