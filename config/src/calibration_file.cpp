@@ -19,9 +19,9 @@
 #include <cstdio>
 #include <fstream>
 #include <optional>
-#include <sstream>
 #include <system_error>
 
+#include "file_io.hpp"
 #include "tacse3/config/toml_names.hpp"
 #include "tacse3/dsp/calibration_fields.hpp"
 
@@ -539,22 +539,12 @@ Status parse_calibration(std::string_view text, const std::string& origin,
 
 Status load_calibration(const std::filesystem::path& file, CalibrationSet* out) noexcept {
   try {
-    const std::string origin = file.string();
-    std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) return Status::error(origin + ": no such file");
-    if (std::filesystem::is_directory(file, ec)) {
-      return Status::error(origin + ": is a directory, expected a calibration file");
+    std::string text, error;
+    if (!detail::read_regular_file(file, kMaxCalibrationBytes, "a calibration file", &text,
+                                   &error)) {
+      return Status::error(error);
     }
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return Status::error(origin + ": cannot open for reading");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) return Status::error(origin + ": read error");
-    const std::string text = ss.str();
-    if (text.size() > (1u << 20)) {
-      return Status::error(origin + ": file is larger than 1 MiB; not a calibration file");
-    }
-    return parse_calibration(text, origin, out);
+    return parse_calibration(text, file.string(), out);
   } catch (...) {
     return Status::error(file.string() + ": unexpected error while reading");
   }

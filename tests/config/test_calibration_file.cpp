@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 // tacse3 tests: the TOML calibration file: round trips, defaults, and errors naming key and file.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <string>
 
 #include "tacse3/config/calibration_file.hpp"
@@ -165,6 +169,61 @@ TEST(CalibrationFile, SaveAndLoadThroughTheDisk) {
   ASSERT_FALSE(isdir.ok());
   EXPECT_NE(isdir.message().find("is a directory"), std::string::npos);
   std::filesystem::remove_all(dir);
+}
+
+namespace fs = std::filesystem;
+
+// A fresh scratch folder per test, removed at the end.
+struct Scratch {
+  explicit Scratch(const std::string& name)
+      : dir(fs::temp_directory_path() /
+            ("tacse3_test_calibration_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  ~Scratch() {
+    std::error_code ec;
+    fs::permissions(dir, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(dir, ec);
+  }
+  fs::path dir;
+};
+
+// load_calibration in a thread, given 5 s. Should it block on the FIFO (the defect), opening the
+// FIFO for writing releases it, so the test fails instead of hanging.
+cfg::Status load_with_deadline(const fs::path& file) {
+  cfg::CalibrationSet out;
+  auto done = std::async(std::launch::async, [&] { return cfg::load_calibration(file, &out); });
+  if (done.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
+    const int fd = ::open(file.c_str(), O_WRONLY | O_NONBLOCK);
+    if (fd >= 0) ::close(fd);
+    ADD_FAILURE() << file << ": load_calibration blocked";
+  }
+  return done.get();
+}
+
+TEST(CalibrationFile, LoadRefusesAFifoOrADeviceAtOnce) {
+  const Scratch s("load_fifo");
+  const fs::path fifo = s.dir / "cal.toml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const cfg::Status f = load_with_deadline(fifo);
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.message().find(fifo.string() + ": is a FIFO, expected a calibration file"),
+            std::string::npos)
+      << f.message();
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  const cfg::Status d = load_with_deadline("/dev/null");
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.message().find("/dev/null: is a character device"), std::string::npos)
+      << d.message();
+  // A sparse file just over the bound is refused by its size, without reading it.
+  const fs::path big = s.dir / "big.toml";
+  std::ofstream(big) << kHead;
+  fs::resize_file(big, cfg::kMaxCalibrationBytes + 1);
+  const cfg::Status b = load_with_deadline(big);
+  ASSERT_FALSE(b.ok());
+  EXPECT_NE(b.message().find("big.toml: file is larger than 1 MiB"), std::string::npos)
+      << b.message();
 }
 
 TEST(CalibrationFile, OverridesAndPaperScales) {

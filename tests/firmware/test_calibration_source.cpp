@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // firmware tests: the daemon's calibration loading and the pipeline configuration it makes.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -39,6 +40,12 @@ TEST(Calibration, BadFilesAreRejectedWithFileAndKey) {
   EXPECT_NE(e.find("sensor.contact_tau_on"), std::string::npos) << e;
   EXPECT_FALSE(load_calibration_source((dir / "absent.toml").string(), &c, &e));
   EXPECT_NE(e.find("absent.toml"), std::string::npos) << e;
+  // A FIFO is refused at once (it blocked the daemon's SIGHUP reload, so that it ignored
+  // SIGTERM). Without a writer it cannot release a blocked open: a hang here is the defect.
+  const fs::path fifo = dir / "fifo.toml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_FALSE(load_calibration_source(fifo.string(), &c, &e));
+  EXPECT_NE(e.find(fifo.string() + ": is a FIFO"), std::string::npos) << e;
   // The fitted simulator calibration loads and makes a valid pipeline configuration.
   ASSERT_TRUE(load_calibration_source(TACSE3_SIM_CALIBRATION, &c, &e)) << e;
   BoardConfig b;

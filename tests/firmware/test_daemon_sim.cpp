@@ -3,6 +3,7 @@
 // (degraded within 3 frame periods, no lost or garbled cycle), replugged (back to dual), a
 // calibration reload that is rejected and one that is applied, and a stop within 1 s.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -80,6 +81,14 @@ TEST(DaemonSim, UnplugDegradesReplugRecoversNoCycleLost) {
   EXPECT_FALSE(d->reload_calibration(&msg));
   EXPECT_NE(msg.find(cal_file.string()), std::string::npos) << msg;
   EXPECT_NE(msg.find("c_velocity"), std::string::npos) << msg;
+  // A FIFO at the path is refused at once; it used to block the reload for good.
+  fs::remove(cal_file);
+  ASSERT_EQ(::mkfifo(cal_file.c_str(), 0600), 0);
+  const auto t_fifo = std::chrono::steady_clock::now();
+  EXPECT_FALSE(d->reload_calibration(&msg));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t_fifo).count(), 1.0);
+  EXPECT_NE(msg.find(cal_file.string() + ": is a FIFO"), std::string::npos) << msg;
+  fs::remove(cal_file);
   fs::copy_file(TACSE3_SIM_CALIBRATION, cal_file, fs::copy_options::overwrite_existing);
   EXPECT_TRUE(d->reload_calibration(&msg)) << msg;
 

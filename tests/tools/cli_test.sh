@@ -1,9 +1,11 @@
 #!/bin/sh
 # SPDX-License-Identifier: Apache-2.0
-# Scripted CLI tests of tacse3-replay and tacse3-calibrate: exit codes, messages, output files.
-# Usage: cli_test.sh BIN_DIR (the build's tools/ folder)
+# Scripted CLI tests of tacse3-replay, tacse3-calibrate, tacse3-sim and (when given) tacse3d:
+# exit codes, messages, output files.
+# Usage: cli_test.sh BIN_DIR [TACSE3D] (BIN_DIR: the build's tools/ folder)
 set -u
 BIN="$1"
+TACSE3D="${2:-}"
 SIM="$BIN/sim/tacse3-sim"
 REPLAY="$BIN/replay/tacse3-replay"
 CAL="$BIN/calibrate/tacse3-calibrate"
@@ -16,6 +18,8 @@ check() {  # check NAME CONDITION...
   if "$@"; then echo "ok   $name"; else echo "FAIL $name"; fails=$((fails + 1)); fi
 }
 contains() { grep -q -- "$2" "$1"; }
+# A FIFO or a device must be an error at once: `timeout` turns a hang into exit 124.
+bounded() { timeout 20 "$@"; }
 
 "$SIM" -q --out "$T/rec" --object sphere --motion rz --magnitude 2 --colour grey \
   --approach-s 0.05 --grasp-s 0.2 --settle-s 0.05 --hold-s 0.1 || { echo "FAIL tacse3-sim"; exit 1; }
@@ -82,6 +86,19 @@ awk -F, -v t0="$t_release" 'NR > 1 && $1 < t0 && $10 > 4 { bad++ } END { exit ba
   "$T/slip.csv"
 check "slip log: no load falling > 4/s before the release" test $? -eq 0
 check "slip log: a 2 deg stick motion never slips" test -z "$(awk -F, 'NR > 1 && $4 != 0' "$T/slip.csv")"
+
+# A FIFO as the calibration file: refused at once (the loader opens without blocking and checks
+# what it opened), and left as it is.
+mkfifo "$T/fifo.toml"
+bounded "$REPLAY" "$T/rec" --calibration "$T/fifo.toml" --out "$T/x.csv" > /dev/null 2> "$T/e5"
+check "replay --calibration FIFO exits 1" test $? -eq 1
+check "replay --calibration FIFO is named" contains "$T/e5" "$T/fifo.toml: is a FIFO"
+if [ -n "$TACSE3D" ]; then
+  bounded "$TACSE3D" --board sim --calibration "$T/fifo.toml" --check > /dev/null 2> "$T/e21"
+  check "tacse3d --calibration FIFO --check exits 1" test $? -eq 1
+  check "tacse3d names the FIFO" contains "$T/e21" "$T/fifo.toml: is a FIFO"
+fi
+check "the FIFO is still a FIFO" test -p "$T/fifo.toml"
 
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"

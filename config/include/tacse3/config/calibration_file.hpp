@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -16,6 +17,8 @@ namespace tacse3::config {
 
 inline constexpr const char* kCalibrationFormat = "tacse3-calibration";
 inline constexpr int kCalibrationVersion = 1;
+// Largest calibration file read: a full file is a few KiB, so anything larger is not one.
+inline constexpr std::size_t kMaxCalibrationBytes = std::size_t{1} << 20;
 
 // Success, or a message that names the file and the key at fault. Nothing in this library
 // throws (the daemon reloads the file on SIGHUP and must keep running on a bad file).
@@ -73,7 +76,9 @@ struct CalibrationSet {
 Status parse_calibration(std::string_view text, const std::string& origin,
                          CalibrationSet* out) noexcept;
 
-// Reads and parses a file (see parse_calibration); errors name the file.
+// Reads and parses a file (see parse_calibration); errors name the file. Only a regular file of
+// at most kMaxCalibrationBytes is read: a FIFO or a device at the path is an error at once,
+// never a wait (the daemon reloads on SIGHUP and must stay responsive).
 Status load_calibration(const std::filesystem::path& file, CalibrationSet* out) noexcept;
 
 // Serialises a set (validated first) as TOML text; every key is written. False + *error on an
