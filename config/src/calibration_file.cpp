@@ -17,9 +17,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <optional>
-#include <system_error>
 
 #include "file_io.hpp"
 #include "tacse3/config/toml_names.hpp"
@@ -610,6 +608,16 @@ bool format_calibration(const CalibrationSet& set, std::string* text, std::strin
   }
 }
 
+Status check_calibration_output(const std::filesystem::path& file) noexcept {
+  try {
+    std::string error;
+    if (!detail::check_output_file(file, &error)) return Status::error(error);
+    return {};
+  } catch (...) {
+    return Status::error(file.string() + ": unexpected error while checking the output file");
+  }
+}
+
 Status save_calibration(const std::filesystem::path& file, const CalibrationSet& set) noexcept {
   try {
     const std::string origin = file.string();
@@ -620,21 +628,7 @@ Status save_calibration(const std::filesystem::path& file, const CalibrationSet&
     if (Status s = parse_calibration(text, origin, &back); !s) {
       return Status::error("internal error: written calibration does not parse: " + s.message());
     }
-    std::filesystem::path tmp = file;
-    tmp += ".tmp";
-    {
-      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      if (!out) return Status::error(tmp.string() + ": cannot open for writing");
-      out << text;
-      out.flush();
-      if (!out) return Status::error(tmp.string() + ": write error");
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, file, ec);
-    if (ec) {
-      std::filesystem::remove(tmp, ec);
-      return Status::error(origin + ": cannot rename the temporary file into place");
-    }
+    if (!detail::write_file_atomically(file, text, &error)) return Status::error(error);
     return {};
   } catch (...) {
     return Status::error(file.string() + ": unexpected error while writing");

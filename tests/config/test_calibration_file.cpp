@@ -10,7 +10,10 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <iterator>
+#include <sstream>
 #include <string>
+#include <utility>
 
 #include "tacse3/config/calibration_file.hpp"
 
@@ -189,6 +192,13 @@ struct Scratch {
   fs::path dir;
 };
 
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 // load_calibration in a thread, given 5 s. Should it block on the FIFO (the defect), opening the
 // FIFO for writing releases it, so the test fails instead of hanging.
 cfg::Status load_with_deadline(const fs::path& file) {
@@ -224,6 +234,81 @@ TEST(CalibrationFile, LoadRefusesAFifoOrADeviceAtOnce) {
   ASSERT_FALSE(b.ok());
   EXPECT_NE(b.message().find("big.toml: file is larger than 1 MiB"), std::string::npos)
       << b.message();
+}
+
+TEST(CalibrationFile, SaveReplacesOnlyARegularFileAndKeepsItsMode) {
+  const Scratch s("save_regular");
+  const fs::path file = s.dir / "cal.toml";
+  std::ofstream(file) << "original\n";
+  fs::permissions(file, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  ASSERT_TRUE(cfg::save_calibration(file, odd_set()).ok());
+  cfg::CalibrationSet back;
+  const cfg::Status l = cfg::load_calibration(file, &back);
+  ASSERT_TRUE(l.ok()) << l.message();
+  expect_same(back.sensor[1], odd_set().sensor[1]);
+  EXPECT_EQ(fs::status(file).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  // The temporary file went into place: nothing else is left in the folder.
+  EXPECT_EQ(std::distance(fs::directory_iterator(s.dir), fs::directory_iterator()), 1);
+}
+
+TEST(CalibrationFile, SaveRefusesSymlinksFifosDirectoriesAndDevices) {
+  const Scratch s("save_refused");
+  const fs::path real = s.dir / "real.toml";
+  std::ofstream(real) << "original\n";
+  const fs::path link = s.dir / "link.toml";
+  fs::create_symlink(real, link);
+  const fs::path fifo = s.dir / "fifo.toml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const fs::path dir = s.dir / "dir.toml";
+  fs::create_directory(dir);
+  const std::pair<fs::path, const char*> cases[] = {
+      {link, "is a symbolic link"}, {fifo, "is a FIFO"}, {dir, "is a directory"}};
+  for (const auto& [target, kind] : cases) {
+    const cfg::Status st = cfg::save_calibration(target, odd_set());
+    ASSERT_FALSE(st.ok()) << target;
+    EXPECT_NE(st.message().find(target.string() + ": " + kind + "; refusing to replace it"),
+              std::string::npos)
+        << st.message();
+  }
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(read_text(real), "original\n");
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  EXPECT_TRUE(fs::is_directory(fs::symlink_status(dir)));
+  EXPECT_EQ(std::distance(fs::directory_iterator(s.dir), fs::directory_iterator()), 4);
+  // /dev/null only through the check that save_calibration makes first: never written to.
+  const cfg::Status null = cfg::check_calibration_output("/dev/null");
+  ASSERT_FALSE(null.ok());
+  EXPECT_NE(null.message().find("/dev/null: is a character device; refusing to replace it"),
+            std::string::npos)
+      << null.message();
+  EXPECT_FALSE(cfg::save_calibration("/dev/null", odd_set()).ok());
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+}
+
+TEST(CalibrationFile, OutputCheckNamesAMissingOrUnwritableDirectory) {
+  const Scratch s("save_dir");
+  const fs::path missing = s.dir / "no-such-dir" / "cal.toml";
+  const cfg::Status m = cfg::check_calibration_output(missing);
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.message().find("the directory " + (s.dir / "no-such-dir").string() +
+                             " does not exist"),
+            std::string::npos)
+      << m.message();
+  EXPECT_FALSE(cfg::save_calibration(missing, odd_set()).ok());
+  EXPECT_TRUE(cfg::check_calibration_output(s.dir / "new.toml").ok());
+  EXPECT_FALSE(cfg::check_calibration_output("").ok());
+  // Root writes anywhere, so the permission case runs only for other users.
+  if (::geteuid() != 0) {
+    const fs::path ro = s.dir / "ro";
+    fs::create_directory(ro);
+    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+    const cfg::Status r = cfg::check_calibration_output(ro / "cal.toml");
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.message().find("cannot write in the directory " + ro.string()), std::string::npos)
+        << r.message();
+    fs::permissions(ro, fs::perms::owner_all);
+  }
 }
 
 TEST(CalibrationFile, OverridesAndPaperScales) {

@@ -100,6 +100,29 @@ if [ -n "$TACSE3D" ]; then
 fi
 check "the FIFO is still a FIFO" test -p "$T/fifo.toml"
 
+# calibrate --out replaces only a regular file or a new path: a symlink, a FIFO, a directory or
+# a device stays as it is (/dev/null is only checked to be refused, never written).
+echo original > "$T/real.toml"
+ln -s "$T/real.toml" "$T/link.toml"
+mkdir "$T/dir.toml"
+for target in "$T/link.toml:a symbolic link" "$T/fifo.toml:a FIFO" "$T/dir.toml:a directory" \
+              "/dev/null:a character device"; do
+  "$CAL" "$T/rec" -q --out "${target%%:*}" > /dev/null 2> "$T/e12"
+  check "calibrate --out ${target#*:} exits 1" test $? -eq 1
+  check "calibrate --out ${target#*:} is refused" \
+    contains "$T/e12" "${target%%:*}: is ${target#*:}; refusing to replace it"
+done
+check "the symlink is still a symlink" test -L "$T/link.toml"
+check "its target is unchanged" test "$(cat "$T/real.toml")" = original
+check "the FIFO is still a FIFO after calibrate" test -p "$T/fifo.toml"
+check "the directory is still a directory" test -d "$T/dir.toml"
+check "/dev/null is still a device" test -c /dev/null
+echo original > "$T/fitted.toml"
+"$CAL" "$T/rec" -q --out "$T/fitted.toml" > /dev/null 2>&1
+check "calibrate over a regular file exits 0" test $? -eq 0
+check "the regular file was replaced" contains "$T/fitted.toml" 'format = "tacse3-calibration"'
+check "no temporary file left" test -z "$(ls -A "$T" | grep 'fitted.toml.tmp')"
+
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"
 check "calibrate without truth exits 1" test $? -eq 1

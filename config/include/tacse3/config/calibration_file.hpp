@@ -85,7 +85,13 @@ Status load_calibration(const std::filesystem::path& file, CalibrationSet* out) 
 // invalid set.
 bool format_calibration(const CalibrationSet& set, std::string* text, std::string* error) noexcept;
 
-// Validates and writes atomically (temporary file + rename), so a daemon never reads half a file.
+// Checks that save_calibration can write `file`: its directory exists and is writable, and
+// `file` is absent or a regular file. Tools call it before a long fit.
+Status check_calibration_output(const std::filesystem::path& file) noexcept;
+
+// Validates and writes atomically (a new file beside `file`, then rename), so a daemon never
+// reads half a file. Only a regular file or a new path is replaced; a symlink, FIFO, device or
+// directory at `file` is an error and stays as it is (check_calibration_output).
 Status save_calibration(const std::filesystem::path& file, const CalibrationSet& set) noexcept;
 
 // Field-by-field validation with messages naming the key ("left.contact_tau_off"); also runs
