@@ -18,6 +18,7 @@ check() {  # check NAME CONDITION...
   if "$@"; then echo "ok   $name"; else echo "FAIL $name"; fails=$((fails + 1)); fi
 }
 contains() { grep -q -- "$2" "$1"; }
+lacks() { ! grep -q -- "$2" "$1"; }
 # A FIFO or a device must be an error at once: `timeout` turns a hang into exit 124.
 bounded() { timeout 20 "$@"; }
 
@@ -122,6 +123,13 @@ echo original > "$T/fitted.toml"
 check "calibrate over a regular file exits 0" test $? -eq 0
 check "the regular file was replaced" contains "$T/fitted.toml" 'format = "tacse3-calibration"'
 check "no temporary file left" test -z "$(ls -A "$T" | grep 'fitted.toml.tmp')"
+
+# calibrate --out is checked before the fit: a recording that cannot even be opened comes second.
+"$CAL" "$T/nope" --out "$T/no-such-dir/cal.toml" > /dev/null 2> "$T/e11"
+check "calibrate into a missing directory exits 1" test $? -eq 1
+check "the missing directory is named before the fit" \
+  contains "$T/e11" "--out: $T/no-such-dir/cal.toml: the directory $T/no-such-dir does not exist"
+check "no fit and no recording read" lacks "$T/e11" "nope"
 
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"

@@ -254,6 +254,14 @@ int main(int argc, char** argv) {
                  "above the shear but for a thin rim of the patch)")
       ->check(CLI::Range(0.01, 5.0));
   CLI11_PARSE(app, argc, argv);
+  // Before the runs, which take minutes: a typo in --calibration-out must not cost them.
+  if (!cal_out.empty()) {
+    if (auto s = tacse3::config::check_calibration_output(cal_out); !s) {
+      std::fprintf(stderr, "tacse3-bench-accuracy: error: --calibration-out: %s\n",
+                   s.message().c_str());
+      return 1;
+    }
+  }
 
   const auto t0 = std::chrono::steady_clock::now();
   const bool tty = tt::stderr_is_tty();

@@ -39,6 +39,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   app.add_flag("-q,--quiet", quiet, "no progress bar and no fit report");
   CLI11_PARSE(app, argc, argv);
+  // Before the fit: a fit can take minutes, and a typo in --out must not cost them.
+  if (auto s = tacse3::config::check_calibration_output(out_file); !s) {
+    return fail("--out: " + s.message());
+  }
 
   tt::CalibrateOptions opt;
   opt.jobs = jobs;
