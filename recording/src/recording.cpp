@@ -2,11 +2,16 @@
 // tacse3 recording: recording.json, frames.csv, truth.csv and sim_labels.csv reading and writing.
 #include "tacse3/recording/recording.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cinttypes>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -216,13 +221,59 @@ bool parse_bool01(std::string_view s, bool* out) {
   return false;
 }
 
-Status read_text(const fs::path& file, const std::string& label, std::string* out) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return err(label + ": cannot open (" + std::strerror(errno) + ")");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) return err(label + ": read error");
-  *out = ss.str();
+// "a FIFO" etc., for a recording file that is not a regular file.
+const char* kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+bool read_fd(int fd, std::size_t max_bytes, std::string* out) {
+  char buf[16384];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return false;
+    if (n == 0) return true;
+    // The file may have grown since fstat: the bound holds for what is read.
+    if (out->size() + static_cast<std::size_t>(n) > max_bytes) {
+      errno = EFBIG;
+      return false;
+    }
+    out->append(buf, static_cast<std::size_t>(n));
+  }
+}
+
+struct FdCloser {
+  int fd;
+  ~FdCloser() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// Reads a regular file of at most max_bytes. O_NONBLOCK: a FIFO with no writer or a device
+// opens at once instead of waiting, and fstat on the descriptor checks the file actually read.
+Status read_text(const fs::path& file, const std::string& label, std::size_t max_bytes,
+                 std::string* out) {
+  const FdCloser f{::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY)};
+  if (f.fd < 0) return err(label + ": cannot open (" + std::strerror(errno) + ")");
+  struct stat st {};
+  if (::fstat(f.fd, &st) != 0) return err(label + ": cannot read (" + std::strerror(errno) + ")");
+  if (!S_ISREG(st.st_mode)) {
+    return err(label + ": is " + kind_of(st.st_mode) +
+               ", not a regular file; replace it with the file the recording needs");
+  }
+  const std::string too_large = label + ": larger than " + std::to_string(max_bytes >> 20) +
+                                " MiB, the reader's limit for this file (docs/recording-format.md)";
+  if (static_cast<std::uintmax_t>(st.st_size) > max_bytes) return err(too_large);
+  out->clear();
+  out->reserve(static_cast<std::size_t>(st.st_size));
+  if (!read_fd(f.fd, max_bytes, out)) {
+    return err(errno == EFBIG ? too_large : label + ": read error (" + std::strerror(errno) + ")");
+  }
   return {};
 }
 
@@ -598,7 +649,19 @@ Status RecordingWriter::finish() {
 
 // --- reader --------------------------------------------------------------------------------
 
-Result<RecordingReader> RecordingReader::open(const fs::path& dir, const ReaderOptions& options) {
+Result<RecordingReader> RecordingReader::open(const fs::path& dir,
+                                              const ReaderOptions& options) noexcept {
+  try {
+    return open_impl(dir, options);
+  } catch (const std::bad_alloc&) {
+    return err(dir.string() + ": out of memory while reading the recording");
+  } catch (const std::exception& e) {
+    return err(dir.string() + ": " + e.what());
+  }
+}
+
+Result<RecordingReader> RecordingReader::open_impl(const fs::path& dir,
+                                                   const ReaderOptions& options) {
   RecordingReader r;
   r.dir_ = dir;
   std::error_code ec;
@@ -606,11 +669,11 @@ Result<RecordingReader> RecordingReader::open(const fs::path& dir, const ReaderO
   const std::string where = dir.string() + "/";
   std::string text;
   if (!fs::exists(dir / "recording.json", ec)) return err(where + "recording.json: missing");
-  if (Status s = read_text(dir / "recording.json", where + "recording.json", &text); !s) return s;
+  if (Status s = read_text(dir / "recording.json", where + "recording.json", kMaxJsonBytes, &text); !s) return s;
   if (Status s = parse_info(text, &r.info_); !s) return err(where + s.message());
 
   if (!fs::exists(dir / "frames.csv", ec)) return err(where + "frames.csv: missing");
-  if (Status s = read_text(dir / "frames.csv", where + "frames.csv", &text); !s) return s;
+  if (Status s = read_text(dir / "frames.csv", where + "frames.csv", kMaxCsvBytes, &text); !s) return s;
   if (Status s = parse_frames(text, &r.t_ns_); !s) return err(where + s.message());
   if (r.t_ns_.empty()) return err(where + "frames.csv: no frames");
 
@@ -656,12 +719,12 @@ Result<RecordingReader> RecordingReader::open(const fs::path& dir, const ReaderO
   }
 
   if (fs::exists(dir / "truth.csv", ec)) {
-    if (Status s = read_text(dir / "truth.csv", where + "truth.csv", &text); !s) return s;
+    if (Status s = read_text(dir / "truth.csv", where + "truth.csv", kMaxCsvBytes, &text); !s) return s;
     if (Status s = parse_truth(text, &r.truth_); !s) return err(where + s.message());
     r.has_truth_ = true;
   }
   if (fs::exists(dir / "sim_labels.csv", ec)) {
-    if (Status s = read_text(dir / "sim_labels.csv", where + "sim_labels.csv", &text); !s) return s;
+    if (Status s = read_text(dir / "sim_labels.csv", where + "sim_labels.csv", kMaxCsvBytes, &text); !s) return s;
     if (Status s = parse_labels(text, &r.labels_); !s) return err(where + s.message());
     r.has_labels_ = true;
   }

@@ -1,13 +1,18 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of the recording format: round trip, and a clear error for every kind of bad input.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "tacse3/recording/recording.hpp"
 
@@ -372,6 +377,67 @@ TEST(Recording, BadCsvRowsAreNamedWithTheirLine) {
   expect_error(tmp.path(), {"frames.csv: no frames"});
   fs::remove(tmp.path() / "frames.csv");
   expect_error(tmp.path(), {"frames.csv: missing"});
+}
+
+// RecordingReader::open in a thread, given 5 s. Should it block on a FIFO (the defect), opening
+// the FIFOs for writing releases it, so the test fails instead of hanging.
+Status open_with_deadline(const fs::path& dir, const std::vector<fs::path>& fifos) {
+  auto done = std::async(std::launch::async, [&] { return RecordingReader::open(dir).status(); });
+  if (done.wait_for(std::chrono::seconds(5)) != std::future_status::ready) {
+    for (const auto& f : fifos) {
+      const int fd = ::open(f.c_str(), O_WRONLY | O_NONBLOCK);
+      if (fd >= 0) ::close(fd);
+    }
+    ADD_FAILURE() << dir << ": RecordingReader::open blocked";
+  }
+  return done.get();
+}
+
+TEST(Recording, TextFilesThatAreNotRegularFilesAreNamedAtOnce) {
+  for (const char* name : {"recording.json", "frames.csv", "truth.csv", "sim_labels.csv"}) {
+    SCOPED_TRACE(name);
+    TempDir tmp;
+    write_valid(tmp.path());
+    const fs::path file = tmp.path() / name;
+    fs::remove(file);
+    ASSERT_EQ(::mkfifo(file.c_str(), 0600), 0);
+    const Status s = open_with_deadline(tmp.path(), {file});
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.message().find(file.string() + ": is a FIFO, not a regular file"),
+              std::string::npos)
+        << s.message();
+    EXPECT_TRUE(fs::is_fifo(fs::symlink_status(file)));
+    // A device behind a symlink (frames.csv -> /dev/zero was the reported case; /dev/null here
+    // so that a reader without the check reads nothing rather than forever).
+    fs::remove(file);
+    fs::create_symlink("/dev/null", file);
+    const Status d = open_with_deadline(tmp.path(), {});
+    ASSERT_FALSE(d.ok());
+    EXPECT_NE(d.message().find(file.string() + ": is a character device"), std::string::npos)
+        << d.message();
+  }
+}
+
+TEST(Recording, TextFilesOverTheirSizeBoundAreRefused) {
+  struct Case {
+    const char* name;
+    std::size_t bound;
+    const char* fragment;
+  };
+  const Case cases[] = {{"recording.json", kMaxJsonBytes, "recording.json: larger than 1 MiB"},
+                        {"frames.csv", kMaxCsvBytes, "frames.csv: larger than 64 MiB"},
+                        {"truth.csv", kMaxCsvBytes, "truth.csv: larger than 64 MiB"},
+                        {"sim_labels.csv", kMaxCsvBytes, "sim_labels.csv: larger than 64 MiB"}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    TempDir tmp;
+    write_valid(tmp.path());
+    // Sparse: the size is refused from fstat, nothing is read or stored.
+    const fs::path file = tmp.path() / c.name;
+    if (!fs::exists(file)) write_file(file, "");
+    fs::resize_file(file, c.bound + 1);
+    expect_error(tmp.path(), {c.fragment});
+  }
 }
 
 TEST(Recording, CrlfAndNoTrailingNewlineAreAccepted) {

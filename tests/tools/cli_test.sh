@@ -131,6 +131,20 @@ check "the missing directory is named before the fit" \
   contains "$T/e11" "--out: $T/no-such-dir/cal.toml: the directory $T/no-such-dir does not exist"
 check "no fit and no recording read" lacks "$T/e11" "nope"
 
+# Recording files that are not regular files: refused at once, naming the file.
+cp -r "$T/rec" "$T/recfifo"
+rm "$T/recfifo/recording.json"
+mkfifo "$T/recfifo/recording.json"
+bounded "$REPLAY" "$T/recfifo" --out "$T/x.csv" > /dev/null 2> "$T/e6"
+check "replay of a FIFO recording.json exits 1" test $? -eq 1
+check "the FIFO recording.json is named" contains "$T/e6" "recfifo/recording.json: is a FIFO"
+rm "$T/recfifo/recording.json" "$T/recfifo/frames.csv"
+cp "$T/rec/recording.json" "$T/recfifo/recording.json"
+ln -s /dev/zero "$T/recfifo/frames.csv"
+bounded "$REPLAY" "$T/recfifo" --out "$T/x.csv" > /dev/null 2> "$T/e7"
+check "replay with frames.csv -> /dev/zero exits 1" test $? -eq 1
+check "frames.csv -> /dev/zero is named" contains "$T/e7" "recfifo/frames.csv: is a character device"
+
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"
 check "calibrate without truth exits 1" test $? -eq 1

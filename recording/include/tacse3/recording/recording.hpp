@@ -20,6 +20,12 @@ inline constexpr const char* kFormatName = "tacse3-recording";
 inline constexpr int kFormatVersion = 1;
 inline constexpr const char* kLayoutMirrored = "mirrored";
 
+// Largest text files the reader accepts. recording.json is a few KiB. A CSV of 64 MiB holds about
+// 3 M frames.csv rows (7 h at 120 Hz), 550 k truth.csv rows (75 min) or 900 k sim_labels.csv
+// rows: beyond any recording so far, while /dev/zero or a runaway file cannot exhaust memory.
+inline constexpr std::size_t kMaxJsonBytes = std::size_t{1} << 20;
+inline constexpr std::size_t kMaxCsvBytes = std::size_t{64} << 20;
+
 // Success, or a message that names the file and the key or line at fault. No API of this
 // library throws.
 class Status {
@@ -204,8 +210,9 @@ class RecordingReader {
     const TruthSample* truth = nullptr;  // truth row with the same t_ns, if any
   };
 
+  // Never throws; running out of memory is an error too.
   static Result<RecordingReader> open(const std::filesystem::path& dir,
-                                      const ReaderOptions& options = {});
+                                      const ReaderOptions& options = {}) noexcept;
 
   const std::filesystem::path& dir() const noexcept { return dir_; }
   const RecordingInfo& info() const noexcept { return info_; }
@@ -228,6 +235,9 @@ class RecordingReader {
   Status read_frame(std::size_t index, Frame* out) const;
 
  private:
+  static Result<RecordingReader> open_impl(const std::filesystem::path& dir,
+                                           const ReaderOptions& options);
+
   std::filesystem::path dir_;
   RecordingInfo info_;
   std::vector<std::int64_t> t_ns_;
