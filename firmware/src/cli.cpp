@@ -56,7 +56,12 @@ bool parse_cli(int argc, const char* const* argv, Options* out, std::string* err
         return false;
       }
     } else if (name == "--calibration") {
+      // An empty value must not mean "none": it would run on the built-in calibration unnoticed.
       if (!take(&o.calibration)) return false;
+      if (o.calibration.empty()) {
+        *error = "--calibration needs a file; leave the option out for the built-in calibration";
+        return false;
+      }
     } else if (name == "--can-log") {
       if (!take(&o.can_log)) return false;
       if (o.can_log.empty()) {
@@ -65,6 +70,10 @@ bool parse_cli(int argc, const char* const* argv, Options* out, std::string* err
       }
     } else if (name == "--can-iface") {
       if (!take(&o.can_iface)) return false;
+      if (o.can_iface.empty()) {
+        *error = "--can-iface needs an interface name; leave the option out for the board's";
+        return false;
+      }
     } else if (name == "--seconds") {
       std::string v;
       if (!take(&v)) return false;
@@ -79,6 +88,10 @@ bool parse_cli(int argc, const char* const* argv, Options* out, std::string* err
       o.seconds = s;
     } else if (name == "--record") {
       if (!take(&o.record_dir)) return false;
+      if (o.record_dir.empty()) {
+        *error = "--record needs a directory; leave the option out to record nothing";
+        return false;
+      }
     } else if (name == "--check" && !has_inline) {
       o.check = true;
     } else if (name == "--quiet" && !has_inline) {

@@ -145,6 +145,30 @@ bounded "$REPLAY" "$T/recfifo" --out "$T/x.csv" > /dev/null 2> "$T/e7"
 check "replay with frames.csv -> /dev/zero exits 1" test $? -eq 1
 check "frames.csv -> /dev/zero is named" contains "$T/e7" "recfifo/frames.csv: is a character device"
 
+# An empty path is a usage error naming the option, never "no file".
+for opt in --calibration --dump-fields --can-log --slip-log --out; do
+  "$REPLAY" "$T/rec" --out "$T/x.csv" "$opt" '' > /dev/null 2> "$T/e8"
+  check "replay $opt '' exits 2" test $? -eq 2
+  check "replay $opt '' is named" contains "$T/e8" "$opt: empty path"
+done
+for opt in --start --out; do
+  "$CAL" "$T/rec" --out "$T/cal.toml" "$opt" '' > /dev/null 2> "$T/e9"
+  check "calibrate $opt '' exits 2" test $? -eq 2
+  check "calibrate $opt '' is named" contains "$T/e9" "$opt: empty path"
+done
+"$SIM" -q --out '' > /dev/null 2> "$T/e10"
+check "sim --out '' exits 2" test $? -eq 2
+check "sim --out '' is named" contains "$T/e10" "--out: empty path"
+if [ -n "$TACSE3D" ]; then
+  for opt in --calibration --record --can-iface; do
+    "$TACSE3D" --board sim --check "$opt" '' > /dev/null 2> "$T/e20"
+    check "tacse3d $opt '' exits 2" test $? -eq 2
+    check "tacse3d $opt '' is named" contains "$T/e20" "tacse3d: $opt needs"
+    "$TACSE3D" --board sim --check "$opt=" > /dev/null 2> "$T/e20"
+    check "tacse3d $opt= exits 2" test $? -eq 2
+  done
+fi
+
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"
 check "calibrate without truth exits 1" test $? -eq 1

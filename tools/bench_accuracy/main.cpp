@@ -13,6 +13,7 @@
 
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/tools/bench.hpp"
+#include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/progress.hpp"
 
 namespace {
@@ -244,16 +245,20 @@ int main(int argc, char** argv) {
   app.add_flag("--quick", quick, "a reduced set (a few recordings per table)");
   app.add_option("-j,--jobs", jobs, "recordings simulated and evaluated in parallel (default 2)")
       ->check(CLI::Range(1, 64));
-  app.add_option("--markdown", markdown, "also write the tables (markdown) to this file");
-  app.add_option("--calibration-out", cal_out, "write the fitted calibration to this file");
+  const CLI::Validator path = tt::non_empty_path();
+  app.add_option("--markdown", markdown, "also write the tables (markdown) to this file")
+      ->check(path);
+  app.add_option("--calibration-out", cal_out, "write the fitted calibration to this file")
+      ->check(path);
   app.add_option("--calibration", cal_in,
-                 "skip the calibration stage and use this calibration file");
+                 "skip the calibration stage and use this calibration file")
+      ->check(path);
   app.add_option("--friction", friction,
                  "simulate every recording the run renders (calibration and test) with this "
                  "object-gel friction coefficient instead of each preset's (5: the cap is far "
                  "above the shear but for a thin rim of the patch)")
       ->check(CLI::Range(0.01, 5.0));
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
   // Before the runs, which take minutes: a typo in --calibration-out must not cost them.
   if (!cal_out.empty()) {
     if (auto s = tacse3::config::check_calibration_output(cal_out); !s) {

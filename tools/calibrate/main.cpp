@@ -8,6 +8,7 @@
 
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/tools/calibrate.hpp"
+#include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/progress.hpp"
 #include "tacse3/tools/source.hpp"
 
@@ -31,14 +32,16 @@ int main(int argc, char** argv) {
   std::string out_file, start_file;
   int jobs = 2;
   bool quiet = false;
-  app.add_option("REC_DIR", dirs, "recording directories with truth.csv")->required();
-  app.add_option("--out", out_file, "calibration file to write (TOML)")->required();
+  const CLI::Validator path = tt::non_empty_path();
+  app.add_option("REC_DIR", dirs, "recording directories with truth.csv")->required()->check(path);
+  app.add_option("--out", out_file, "calibration file to write (TOML)")->required()->check(path);
   app.add_option("--start", start_file,
-                 "calibration to start from (default: the documented defaults)");
+                 "calibration to start from (default: the documented defaults)")
+      ->check(path);
   app.add_option("-j,--jobs", jobs, "recordings processed in parallel (default 2)")
       ->check(CLI::Range(1, 64));
   app.add_flag("-q,--quiet", quiet, "no progress bar and no fit report");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
   // Before the fit: a fit can take minutes, and a typo in --out must not cost them.
   if (auto s = tacse3::config::check_calibration_output(out_file); !s) {
     return fail("--out: " + s.message());

@@ -7,6 +7,7 @@
 
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/tools/can_log.hpp"
+#include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/field_dump.hpp"
 #include "tacse3/tools/progress.hpp"
 #include "tacse3/tools/replay.hpp"
@@ -51,23 +52,31 @@ int main(int argc, char** argv) {
   std::string rec_dir, cal_file, out_file, method = "joint", mode = "auto", sensors = "both";
   std::string dump_dir, can_log, slip_log;
   bool quiet = false;
-  app.add_option("REC_DIR", rec_dir, "recording directory (docs/recording-format.md)")->required();
+  const CLI::Validator path = tt::non_empty_path();
+  app.add_option("REC_DIR", rec_dir, "recording directory (docs/recording-format.md)")
+      ->required()
+      ->check(path);
   app.add_option("--calibration", cal_file,
-                 "calibration file (docs/calibration.md); default: the documented defaults");
+                 "calibration file (docs/calibration.md); default: the documented defaults")
+      ->check(path);
   app.add_option("--out", out_file, "output CSV, one row per frame ('-' = standard output)")
-      ->required();
+      ->required()
+      ->check(path);
   app.add_option("--method", method, "dual-sensor fusion: joint (default) or paper")
       ->check(CLI::IsMember({"paper", "joint"}));
   app.add_option("--mode", mode, "velocity proxy: auto (default), velocity or displacement")
       ->check(CLI::IsMember({"auto", "velocity", "displacement"}));
   app.add_option("--sensors", sensors, "sensors to use: both (default), left or right")
       ->check(CLI::IsMember({"both", "left", "right"}));
-  app.add_option("--dump-fields", dump_dir, "write per-frame fields as .npy files into DIR");
-  app.add_option("--can-log", can_log, "write the firmware's CAN frames as a candump -L log");
+  app.add_option("--dump-fields", dump_dir, "write per-frame fields as .npy files into DIR")
+      ->check(path);
+  app.add_option("--can-log", can_log, "write the firmware's CAN frames as a candump -L log")
+      ->check(path);
   app.add_option("--slip-log", slip_log,
-                 "write the stick/slip detector's per-frame decision and features as CSV");
+                 "write the stick/slip detector's per-frame decision and features as CSV")
+      ->check(path);
   app.add_flag("-q,--quiet", quiet, "no progress bar and no summary");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   tt::ReplayOptions opt;
   (void)tt::parse_method(method, &opt.method);

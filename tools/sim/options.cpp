@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "tacse3/sim/object.hpp"
+#include "tacse3/tools/cli.hpp"
 
 namespace tacse3::tools {
 
@@ -14,7 +15,9 @@ int parse_options(int argc, char** argv, Options* o) {
       "tacse3-sim: render a simulated grasp of an object between two mirrored DM-Tac sensors,\n"
       "then a commanded motion and a hold, as a recording directory with truth.csv\n"
       "(docs/simulator.md, docs/recording-format.md)."};
-  app.add_option("-o,--out", o->out, "Output recording directory")->required();
+  app.add_option("-o,--out", o->out, "Output recording directory")
+      ->required()
+      ->check(non_empty_path());
   app.add_option("--object", o->object,
                  std::string("Object preset: ") + tacse3::sim::object_preset_names())
       ->capture_default_str();
@@ -64,12 +67,7 @@ int parse_options(int argc, char** argv, Options* o) {
   app.add_option("-j,--jobs", o->jobs, "Threads (1, or 2: one per sensor)")->capture_default_str();
   app.add_flag("--overwrite", o->overwrite, "Replace an existing recording in --out");
   app.add_flag("-q,--quiet", o->quiet, "No progress bar and no summary");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
-  return -1;
+  return parse_command_line(app, argc, argv);
 }
 
 }  // namespace tacse3::tools

@@ -35,7 +35,7 @@ struct Options {
   bool quiet = false;
 };
 
-// Parses argv into *o. Returns -1 to go on, or the exit code (help shown, or a usage error).
+// Parses argv into *o. Returns -1 to go on, or the exit code (0: help shown, 2: a usage error).
 int parse_options(int argc, char** argv, Options* o);
 
 }  // namespace tacse3::tools

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 tools: command-line rules shared by the CLI11 tools (header-only: included only by tools
+// that link CLI11; tacse3_tools_common itself does not use it).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace tacse3::tools {
+
+// For every option that takes a path: an empty value is a usage error naming the option. It must
+// never mean "no file" (`--calibration ''` would run with the defaults without a word).
+inline CLI::Validator non_empty_path() {
+  return CLI::Validator(
+      [](std::string& v) {
+        return v.empty() ? std::string("empty path; give a file name or leave the option out")
+                         : std::string();
+      },
+      "");
+}
+
+// Parses the command line. Returns -1 to go on, else the exit code: 0 after --help, 2 for a
+// usage error (the same as tacse3d).
+inline int parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  return -1;
+}
+
+}  // namespace tacse3::tools
