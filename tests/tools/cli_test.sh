@@ -1,7 +1,7 @@
 #!/bin/sh
 # SPDX-License-Identifier: Apache-2.0
-# Scripted CLI tests of tacse3-replay, tacse3-calibrate, tacse3-sim and (when given) tacse3d:
-# exit codes, messages, output files.
+# Scripted CLI tests of tacse3-replay, tacse3-calibrate, tacse3-sim, tacse3-canmon and (when
+# given) tacse3d: exit codes, messages, output files.
 # Usage: cli_test.sh BIN_DIR [TACSE3D] (BIN_DIR: the build's tools/ folder)
 set -u
 BIN="$1"
@@ -9,6 +9,7 @@ TACSE3D="${2:-}"
 SIM="$BIN/sim/tacse3-sim"
 REPLAY="$BIN/replay/tacse3-replay"
 CAL="$BIN/calibrate/tacse3-calibrate"
+CANMON="$BIN/canmon/tacse3-canmon"
 T="${TMPDIR:-/tmp}/tacse3_cli_test.$$"
 mkdir -p "$T"
 trap 'rm -rf "$T"' EXIT
@@ -167,6 +168,27 @@ if [ -n "$TACSE3D" ]; then
     "$TACSE3D" --board sim --check "$opt=" > /dev/null 2> "$T/e20"
     check "tacse3d $opt= exits 2" test $? -eq 2
   done
+fi
+
+# Results on a full standard output are an error, not exit 0.
+"$REPLAY" "$T/rec" --out - > /dev/full 2> "$T/e14"
+check "replay --out - > /dev/full exits 1" test $? -eq 1
+check "replay names the stdout write error" \
+  contains "$T/e14" "tacse3-replay: error: standard output: write error"
+"$REPLAY" "$T/rec" --out "$T/x.csv" > /dev/full 2> "$T/e15"
+check "replay summary to /dev/full exits 1" test $? -eq 1
+"$CAL" "$T/rec" --out "$T/fitted2.toml" > /dev/full 2> "$T/e13"
+check "calibrate report to /dev/full exits 1" test $? -eq 1
+check "calibrate names the stdout write error" contains "$T/e13" "standard output: write error"
+"$SIM" --out "$T/full" --object sphere --motion rz --magnitude 2 --colour grey --approach-s 0.05 \
+  --grasp-s 0.1 --settle-s 0.05 --hold-s 0.05 > /dev/full 2> "$T/e16"
+check "sim summary to /dev/full exits 1" test $? -eq 1
+check "sim names the stdout write error" contains "$T/e16" "standard output: write error"
+if [ -x "$CANMON" ]; then
+  "$REPLAY" "$T/rec" --out "$T/x.csv" --can-log "$T/can.log" -q
+  "$CANMON" --log "$T/can.log" --format csv > /dev/full 2> "$T/e17"
+  check "canmon to /dev/full exits 1" test $? -eq 1
+  check "canmon names the stdout write error" contains "$T/e17" "standard output: write error"
 fi
 
 rm "$T/rec/truth.csv"

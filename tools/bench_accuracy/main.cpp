@@ -230,9 +230,7 @@ bool is_rotation(const SimCase& c) {
   return c.motion[0] == 'r';
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{
       "Accuracy benchmark: simulates a calibration set and a separate test set, calibrates on the "
       "first with tacse3-calibrate's fit, evaluates the second through tacse3-replay's engine and "
@@ -586,4 +584,11 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Every path out of run() goes through here: the tables are on stdout.
+  return tt::finish_stdout("tacse3-bench-accuracy", run(argc, argv));
 }

@@ -21,9 +21,7 @@ int fail(const std::string& msg) {
   return 1;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{
       "Fits a tacse3 calibration file from recordings that carry truth.csv, by running the "
       "firmware's fixed-point pipeline over them (docs/calibration.md). The recordings may mix "
@@ -81,4 +79,11 @@ int main(int argc, char** argv) {
     std::printf("tacse3-calibrate: wrote %s\n", out_file.c_str());
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Every path out of run() goes through here: the fit report is on stdout.
+  return tt::finish_stdout("tacse3-calibrate", run(argc, argv));
 }

@@ -3,8 +3,10 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -135,7 +137,16 @@ int main(int argc, char** argv) {
   }
   if (tty != nullptr) tty->draw();
   if (json != nullptr) json->stats("summary");
-  std::fflush(stdout);
+  // The decoded frames are the result: a write error on stdout (a full disk) must not exit 0.
+  errno = 0;
+  const bool out_ok = std::fflush(stdout) == 0 && std::ferror(stdout) == 0;
+  const int out_errno = errno;
+  if (!out_ok) {
+    std::cerr << "tacse3-canmon: error: standard output: write error"
+              << (out_errno != 0 ? std::string(" (") + std::strerror(out_errno) + ")" : "")
+              << "; the output is incomplete\n";
+    rc = 1;
+  }
   if (auto* log = dynamic_cast<can::LogChannel*>(channel.get());
       log != nullptr && log->bad_lines() > 0) {
     std::cerr << "tacse3-canmon: skipped " << log->bad_lines()

@@ -43,9 +43,7 @@ void print_tracking(std::FILE* report, const tt::TrackingError& t) {
                t.translation_rms_mm, t.translation_max_mm, t.translation_lag_s * 1e3);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{
       "Replays a tacse3 recording through the firmware's fixed-point pipeline (dsp::DualPipeline) "
       "and writes the estimated twist and pose per frame (docs/replay.md)."};
@@ -147,7 +145,6 @@ int main(int argc, char** argv) {
   const tt::ReplayRun run = tt::run_replay(*source, opt, sinks);
   bar.finish();
   if (!to_stdout && std::fclose(csv) != 0) return fail(out_file + ": write error");
-  if (to_stdout) std::fflush(stdout);
   if (slip != nullptr && std::fclose(slip) != 0) return fail(slip_log + ": write error");
   if (!run.error.empty()) return fail(run.error);
   if (sinks.dump != nullptr) {
@@ -195,4 +192,11 @@ int main(int argc, char** argv) {
                  "decision yet)\n");
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Every path out of run() goes through here: the CSV (--out -) or the summary is on stdout.
+  return tt::finish_stdout("tacse3-replay", run(argc, argv));
 }

@@ -13,6 +13,7 @@
 #include "options.hpp"
 #include "tacse3/recording/recording.hpp"
 #include "tacse3/sim/simulator.hpp"
+#include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/progress.hpp"
 #include "tacse3/tools/sim_source.hpp"
 
@@ -37,9 +38,7 @@ std::string command_line(int argc, char** argv) {
   return s;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   Options o;
   if (const int rc = parse_options(argc, argv, &o); rc >= 0) return rc;
 
@@ -232,4 +231,11 @@ int main(int argc, char** argv) {
         simulator->finger_separation_mm(), secs, frames * static_cast<double>(nsens) / secs);
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Every path out of run() goes through here: the summary is on stdout.
+  return tacse3::tools::finish_stdout("tacse3-sim", run(argc, argv));
 }

@@ -4,6 +4,9 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <string>
 
 namespace tacse3::tools {
@@ -28,6 +31,20 @@ inline int parse_command_line(CLI::App& app, int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   return -1;
+}
+
+// Flushes and closes standard output at the end of a tool: results that did not arrive (a full
+// disk, /dev/full) must not end in exit 0. Returns rc, or 1 if rc is 0 and a write failed.
+inline int finish_stdout(const char* tool, int rc) {
+  errno = 0;
+  bool ok = std::fflush(stdout) == 0 && std::ferror(stdout) == 0;
+  const int e = errno;  // set when the last flush failed; an earlier failed write left only ferror
+  ok = std::fclose(stdout) == 0 && ok;
+  if (ok) return rc;
+  const std::string why = e != 0 ? std::string(" (") + std::strerror(e) + ")" : std::string();
+  std::fprintf(stderr, "%s: error: standard output: write error%s; the output is incomplete\n",
+               tool, why.c_str());
+  return rc != 0 ? rc : 1;
 }
 
 }  // namespace tacse3::tools
