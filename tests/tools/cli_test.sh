@@ -191,6 +191,16 @@ if [ -x "$CANMON" ]; then
   check "canmon names the stdout write error" contains "$T/e17" "standard output: write error"
 fi
 
+# Too short a recording for a fit: refused, naming the recording and its frame count.
+cp -r "$T/rec" "$T/rec1"
+head -2 "$T/rec/frames.csv" > "$T/rec1/frames.csv"
+find "$T/rec1" -name '*.png' ! -name 000000.png -delete
+"$CAL" "$T/rec1" --out "$T/cal1.toml" > /dev/null 2> "$T/e18"
+check "calibrate on a 1-frame recording exits 1" test $? -eq 1
+check "the short recording and its count are named" \
+  contains "$T/e18" "$T/rec1: 1 frame(s); calibration needs at least 16"
+check "no calibration from a 1-frame recording" test ! -e "$T/cal1.toml"
+
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"
 check "calibrate without truth exits 1" test $? -eq 1

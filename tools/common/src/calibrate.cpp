@@ -510,6 +510,11 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     if (!s->info().has_truth()) {
       return s->info().name + ": has no truth.csv; calibration needs recordings with truth";
     }
+    if (s->info().frame_count() < kMinCalibrationFrames) {
+      return s->info().name + ": " + std::to_string(s->info().frame_count()) +
+             " frame(s); calibration needs at least " + std::to_string(kMinCalibrationFrames) +
+             " per recording (a grasp, a motion and a rest)";
+    }
   }
   auto log = [&](const std::string& m) {
     if (opt.log) opt.log(m);

@@ -13,6 +13,11 @@
 
 namespace tacse3::tools {
 
+// Fewest frames a recording must have for the fit. The first frame is the pipeline's reference
+// and the moving average and the slip detector need several more before a twist means anything;
+// a real grasp has hundreds, so this only stops stubs (a 1-frame recording gave a "calibration").
+inline constexpr std::size_t kMinCalibrationFrames = 16;
+
 struct CalibrateOptions {
   config::CalibrationSet start{};  // starting values (the documented defaults)
   int jobs = 1;                    // recordings processed in parallel (one thread each)
