@@ -374,8 +374,8 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
     rd.only_keys(*t, p,
                  {"finger_separation_m", "method", "velocity_proxy", "pair_tolerance_us",
                   "stale_ms", "lost_ms"});
-    // The range of SET_FINGER_SEPARATION (docs/can-protocol.md).
-    rd.real(*t, "finger_separation_m", p, 0.001, 0.25, &b.pipeline.finger_separation_m);
+    rd.real(*t, "finger_separation_m", p, kMinFingerSeparationM, kMaxFingerSeparationM,
+            &b.pipeline.finger_separation_m);
     rd.choice<dsp::FusionMethod>(
         *t, "method", p,
         {{"joint", dsp::FusionMethod::kJoint}, {"paper", dsp::FusionMethod::kPaper}},

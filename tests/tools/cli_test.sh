@@ -201,6 +201,15 @@ check "the short recording and its count are named" \
   contains "$T/e18" "$T/rec1: 1 frame(s); calibration needs at least 16"
 check "no calibration from a 1-frame recording" test ! -e "$T/cal1.toml"
 
+# A finger separation outside the board files' range (1 .. 250 mm) is refused by replay.
+cp -r "$T/rec" "$T/recw"
+sed 's/"finger_separation_mm": [0-9.]*/"finger_separation_mm": 1e-9/' "$T/rec/recording.json" \
+  > "$T/recw/recording.json"
+"$REPLAY" "$T/recw" --out "$T/x.csv" > /dev/null 2> "$T/e19"
+check "replay with a 1e-9 mm finger separation exits 1" test $? -eq 1
+check "the separation and the range are named" \
+  contains "$T/e19" "rig.finger_separation_mm 1e-09 is outside 1 .. 250 mm"
+
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"
 check "calibrate without truth exits 1" test $? -eq 1

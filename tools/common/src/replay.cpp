@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include "tacse3/config/board_file.hpp"
 #include "tacse3/tools/can_log.hpp"
 #include "tacse3/tools/field_dump.hpp"
 #include "tacse3/tools/progress.hpp"
@@ -98,6 +100,25 @@ bool pipeline_has_auto() noexcept {
   return true;
 }
 
+namespace {
+
+// The rig's finger separation must be one a board file allows: a value far outside it (1e-9 mm)
+// would otherwise run with a meaningless lever arm and report nothing.
+std::string check_separation(const SourceInfo& info) {
+  const double lo_mm = config::kMinFingerSeparationM * 1e3;
+  const double hi_mm = config::kMaxFingerSeparationM * 1e3;
+  const double w = info.finger_separation_mm;
+  if (w >= lo_mm && w <= hi_mm) return {};
+  char buf[192];
+  std::snprintf(buf, sizeof buf,
+                "/recording.json: rig.finger_separation_mm %.6g is outside %g .. %g mm, the range "
+                "of board files; correct the rig block",
+                w, lo_mm, hi_mm);
+  return info.name + buf;
+}
+
+}  // namespace
+
 std::optional<bool> detected_slip(const dsp::SensorResult& r) noexcept {
   if (!r.processed || r.degraded) return std::nullopt;
   return r.slipping;
@@ -146,10 +167,7 @@ std::string make_setup(const SourceInfo& info, const ReplayOptions& options, Eng
   }
   s.dual.fusion.method = options.method;
   s.dual.finger_separation_m = info.finger_separation_mm * 1e-3;
-  if (!(s.dual.finger_separation_m >= 0.0 && s.dual.finger_separation_m <= 0.5)) {
-    return info.name + "/recording.json: rig.finger_separation_mm " +
-           std::to_string(info.finger_separation_mm) + " is outside 0 .. 500 mm";
-  }
+  if (std::string e = check_separation(info); !e.empty()) return e;
   // Nominal period: the median frame step (used for the first frame only).
   if (info.t_ns.size() >= 2) {
     std::vector<std::int64_t> d;

@@ -45,6 +45,11 @@ struct SimBoardConfig {
   bool realtime = true;
 };
 
+// The finger separation range of board files, the same as SET_FINGER_SEPARATION's
+// (docs/can-protocol.md); replay holds recordings to it too.
+inline constexpr double kMinFingerSeparationM = 0.001;
+inline constexpr double kMaxFingerSeparationM = 0.25;
+
 // [pipeline]
 struct PipelineBoardConfig {
   double finger_separation_m = 0.040;
