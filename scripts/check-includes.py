@@ -2,8 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The dependency rule, checked over every #include line of the source tree.
 
-    dsp, protocol              know nothing of the rest
-    sim, config, recording     know dsp and protocol only
+    dsp, protocol, fileio      know nothing of the rest
+    sim, config, recording     know dsp, protocol and fileio only
     hal                        wraps the OS; may use the layers above
     firmware, tools            wire everything together (neither includes the other)
 
@@ -22,6 +22,7 @@ PREFIX_MODULE = {
     "dsp_ref": "dsp_ref",
     "protocol": "protocol",
     "protocol_dbc": "protocol",
+    "fileio": "fileio",
     "sim": "sim",
     "config": "config",
     "recording": "recording",
@@ -30,13 +31,14 @@ PREFIX_MODULE = {
     "tools": "tools",
 }
 
-BOTTOM = {"dsp", "protocol"}
+BOTTOM = {"dsp", "protocol", "fileio"}
 MIDDLE = BOTTOM | {"sim", "config", "recording"}
 # Source folder (relative to ROOT) -> the modules its files may include. Longest match wins.
 ALLOWED = {
     "dsp": {"dsp"},
     "dsp/reference": {"dsp", "dsp_ref"},
     "protocol": {"protocol"},
+    "fileio": {"fileio"},
     "sim": MIDDLE - {"config", "recording"},
     "config": MIDDLE - {"sim", "recording"},
     "recording": MIDDLE - {"sim", "config"},

@@ -19,9 +19,9 @@
 #include <cstdio>
 #include <optional>
 
-#include "file_io.hpp"
 #include "tacse3/config/toml_names.hpp"
 #include "tacse3/dsp/calibration_fields.hpp"
+#include "tacse3/fileio/file_io.hpp"
 
 namespace tacse3::config {
 namespace {
@@ -404,6 +404,27 @@ std::string value_text(const Calibration& c, const Field& f) {
   return "";
 }
 
+// Why the calibration file could not be read, and what to give instead.
+std::string read_error_message(const std::string& name, const fileio::ReadResult& r) {
+  switch (r.error) {
+    case fileio::ReadError::kNone:
+      break;
+    case fileio::ReadError::kNotFound:
+      return name + ": no such file";
+    case fileio::ReadError::kOpen:
+      return name + ": cannot open for reading" + fileio::os_error(r.os_errno);
+    case fileio::ReadError::kNotRegular:
+      return name + ": is " + r.kind +
+             ", expected a calibration file (a regular file); give the path of one";
+    case fileio::ReadError::kTooLarge:
+      return name + ": file is larger than " + fileio::size_text(kMaxCalibrationBytes) +
+             "; not a calibration file";
+    case fileio::ReadError::kRead:
+      return name + ": read error" + fileio::os_error(r.os_errno);
+  }
+  return name + ": unexpected error while reading";
+}
+
 // A rule's operand (rules name real fields: tests/dsp/test_calibration_fields.cpp).
 double rule_operand(const Calibration& c, const char* key) {
   const Field* f = dsp::find_calibration_field(key);
@@ -537,11 +558,9 @@ Status parse_calibration(std::string_view text, const std::string& origin,
 
 Status load_calibration(const std::filesystem::path& file, CalibrationSet* out) noexcept {
   try {
-    std::string text, error;
-    if (!detail::read_regular_file(file, kMaxCalibrationBytes, "a calibration file", &text,
-                                   &error)) {
-      return Status::error(error);
-    }
+    std::string text;
+    const fileio::ReadResult r = fileio::read_regular_file(file, kMaxCalibrationBytes, &text);
+    if (!r.ok()) return Status::error(read_error_message(file.string(), r));
     return parse_calibration(text, file.string(), out);
   } catch (...) {
     return Status::error(file.string() + ": unexpected error while reading");
@@ -611,7 +630,7 @@ bool format_calibration(const CalibrationSet& set, std::string* text, std::strin
 Status check_calibration_output(const std::filesystem::path& file) noexcept {
   try {
     std::string error;
-    if (!detail::check_output_file(file, &error)) return Status::error(error);
+    if (!fileio::check_output_file(file, &error)) return Status::error(error);
     return {};
   } catch (...) {
     return Status::error(file.string() + ": unexpected error while checking the output file");
@@ -628,7 +647,7 @@ Status save_calibration(const std::filesystem::path& file, const CalibrationSet&
     if (Status s = parse_calibration(text, origin, &back); !s) {
       return Status::error("internal error: written calibration does not parse: " + s.message());
     }
-    if (!detail::write_file_atomically(file, text, &error)) return Status::error(error);
+    if (!fileio::write_file_atomically(file, text, &error)) return Status::error(error);
     return {};
   } catch (...) {
     return Status::error(file.string() + ": unexpected error while writing");

@@ -2,10 +2,6 @@
 // tacse3 recording: recording.json, frames.csv, truth.csv and sim_labels.csv reading and writing.
 #include "tacse3/recording/recording.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -18,6 +14,8 @@
 #include <sstream>
 #include <string_view>
 #include <system_error>
+
+#include "tacse3/fileio/file_io.hpp"
 
 namespace tacse3::recording {
 namespace fs = std::filesystem;
@@ -221,60 +219,26 @@ bool parse_bool01(std::string_view s, bool* out) {
   return false;
 }
 
-// "a FIFO" etc., for a recording file that is not a regular file.
-const char* kind_of(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
-
-bool read_fd(int fd, std::size_t max_bytes, std::string* out) {
-  char buf[16384];
-  for (;;) {
-    const ssize_t n = ::read(fd, buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) return false;
-    if (n == 0) return true;
-    // The file may have grown since fstat: the bound holds for what is read.
-    if (out->size() + static_cast<std::size_t>(n) > max_bytes) {
-      errno = EFBIG;
-      return false;
-    }
-    out->append(buf, static_cast<std::size_t>(n));
-  }
-}
-
-struct FdCloser {
-  int fd;
-  ~FdCloser() {
-    if (fd >= 0) ::close(fd);
-  }
-};
-
-// Reads a regular file of at most max_bytes. O_NONBLOCK: a FIFO with no writer or a device
-// opens at once instead of waiting, and fstat on the descriptor checks the file actually read.
+// Reads a regular file of at most max_bytes; a FIFO or a device is an error at once.
 Status read_text(const fs::path& file, const std::string& label, std::size_t max_bytes,
                  std::string* out) {
-  const FdCloser f{::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY)};
-  if (f.fd < 0) return err(label + ": cannot open (" + std::strerror(errno) + ")");
-  struct stat st {};
-  if (::fstat(f.fd, &st) != 0) return err(label + ": cannot read (" + std::strerror(errno) + ")");
-  if (!S_ISREG(st.st_mode)) {
-    return err(label + ": is " + kind_of(st.st_mode) +
-               ", not a regular file; replace it with the file the recording needs");
+  const fileio::ReadResult r = fileio::read_regular_file(file, max_bytes, out);
+  switch (r.error) {
+    case fileio::ReadError::kNone:
+      return {};
+    case fileio::ReadError::kNotFound:
+    case fileio::ReadError::kOpen:
+      return err(label + ": cannot open" + fileio::os_error(r.os_errno));
+    case fileio::ReadError::kNotRegular:
+      return err(label + ": is " + r.kind +
+                 ", not a regular file; replace it with the file the recording needs");
+    case fileio::ReadError::kTooLarge:
+      return err(label + ": larger than " + fileio::size_text(max_bytes) +
+                 ", the reader's limit for this file (docs/recording-format.md)");
+    case fileio::ReadError::kRead:
+      break;
   }
-  const std::string too_large = label + ": larger than " + std::to_string(max_bytes >> 20) +
-                                " MiB, the reader's limit for this file (docs/recording-format.md)";
-  if (static_cast<std::uintmax_t>(st.st_size) > max_bytes) return err(too_large);
-  out->clear();
-  out->reserve(static_cast<std::size_t>(st.st_size));
-  if (!read_fd(f.fd, max_bytes, out)) {
-    return err(errno == EFBIG ? too_large : label + ": read error (" + std::strerror(errno) + ")");
-  }
-  return {};
+  return err(label + ": read error" + fileio::os_error(r.os_errno));
 }
 
 // Calls row(line_no, fields) for each data row after checking the header. Blank lines are

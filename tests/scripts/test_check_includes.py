@@ -33,6 +33,8 @@ cases = [
     ("dsp/include/tacse3/dsp/b.hpp", "#include <vector>\n", "may not include <vector>"),
     ("dsp/src/c.cpp", '#include "tacse3/dsp_ref/x.hpp"\n', 'dsp/ may not include "tacse3/dsp_ref/x.hpp"'),
     ("protocol/src/d.cpp", '#include "tacse3/dsp/types.hpp"\n', 'protocol/ may not include'),
+    ("dsp/src/d2.cpp", '#include "tacse3/fileio/file_io.hpp"\n', 'dsp/ may not include'),
+    ("fileio/src/d3.cpp", '#include "tacse3/dsp/types.hpp"\n', 'fileio/ may not include'),
     ("sim/src/e.cpp", '#include "tacse3/config/board_file.hpp"\n', 'sim/ may not include'),
     ("config/src/f.cpp", '#include "tacse3/hal/gpio.hpp"\n', 'config/ may not include'),
     ("recording/src/g.cpp", '#include "tacse3/sim/pad.hpp"\n', 'recording/ may not include'),
@@ -46,6 +48,7 @@ with tempfile.TemporaryDirectory() as tmp:
     write(tree, "hal/camera/src/ok.cpp",
           '#include "tacse3/sim/pad.hpp"\n#include "tacse3/recording/recording.hpp"\n#include <vector>\n')
     write(tree, "dsp/reference/src/ok.cpp", '#include "tacse3/dsp_ref/x.hpp"\n#include <vector>\n')
+    write(tree, "config/src/ok.cpp", '#include "tacse3/fileio/file_io.hpp"\n#include "tacse3/dsp/x.hpp"\n')
     clean = run(tree)
     if clean.returncode != 0:
         failures.append("a clean tree was refused:\n" + clean.stdout)

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 config: bounded reads of regular files and atomic replacement (POSIX).
-#include "file_io.hpp"
+// tacse3 fileio: bounded reads of regular files and atomic replacement (POSIX).
+#include "tacse3/fileio/file_io.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,14 +11,10 @@
 #include <cstdint>
 #include <cstring>
 
-namespace tacse3::config::detail {
+namespace tacse3::fileio {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string os_error(int err) {
-  return std::string(" (") + std::strerror(err) + ")";
-}
 
 // "a FIFO" etc., for messages about a path that is not a regular file.
 const char* kind_of(mode_t mode) {
@@ -29,11 +25,6 @@ const char* kind_of(mode_t mode) {
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISSOCK(mode)) return "a socket";
   return "not a regular file";
-}
-
-std::string size_text(std::size_t bytes) {
-  if (bytes % (1u << 20) == 0) return std::to_string(bytes >> 20) + " MiB";
-  return std::to_string(bytes) + " bytes";
 }
 
 // Closes the descriptor and, unless kept, removes the file it was created as.
@@ -102,42 +93,54 @@ bool create_temporary(const fs::path& file, OwnedFile* tmp, std::string* error) 
 
 }  // namespace
 
-bool read_regular_file(const fs::path& file, std::size_t max_bytes, const char* what,
-                       std::string* out, std::string* error) {
-  const std::string name = file.string();
+std::string os_error(int err) { return std::string(" (") + std::strerror(err) + ")"; }
+
+std::string size_text(std::size_t bytes) {
+  if (bytes % (1u << 20) == 0) return std::to_string(bytes >> 20) + " MiB";
+  return std::to_string(bytes) + " bytes";
+}
+
+ReadResult read_regular_file(const fs::path& file, std::size_t max_bytes,
+                             std::string* out) noexcept {
+  ReadResult r;
   // O_NONBLOCK: opening a FIFO with no writer, or a device, returns at once instead of waiting;
   // fstat on the descriptor then checks the very file that would be read.
   OwnedFile f;
   f.fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
   if (f.fd < 0) {
-    *error = errno == ENOENT ? name + ": no such file"
-                             : name + ": cannot open for reading" + os_error(errno);
-    return false;
+    r.error = errno == ENOENT ? ReadError::kNotFound : ReadError::kOpen;
+    r.os_errno = errno;
+    return r;
   }
   struct stat st {};
   if (::fstat(f.fd, &st) != 0) {
-    *error = name + ": cannot read" + os_error(errno);
-    return false;
+    r.error = ReadError::kRead;
+    r.os_errno = errno;
+    return r;
   }
   if (!S_ISREG(st.st_mode)) {
-    *error = name + ": is " + kind_of(st.st_mode) + ", expected " + what +
-             " (a regular file); give the path of one";
-    return false;
+    r.error = ReadError::kNotRegular;
+    r.kind = kind_of(st.st_mode);
+    return r;
   }
-  const std::string too_large =
-      name + ": file is larger than " + size_text(max_bytes) + "; not " + what;
   if (static_cast<std::uintmax_t>(st.st_size) > max_bytes) {
-    *error = too_large;
-    return false;
+    r.error = ReadError::kTooLarge;
+    return r;
   }
-  std::string text;
-  text.reserve(static_cast<std::size_t>(st.st_size));
-  if (!read_all(f.fd, max_bytes, &text)) {
-    *error = errno == EFBIG ? too_large : name + ": read error" + os_error(errno);
-    return false;
+  try {
+    std::string text;
+    text.reserve(static_cast<std::size_t>(st.st_size));
+    if (!read_all(f.fd, max_bytes, &text)) {
+      r.error = errno == EFBIG ? ReadError::kTooLarge : ReadError::kRead;
+      r.os_errno = errno;
+      return r;
+    }
+    *out = std::move(text);
+  } catch (...) {
+    r.error = ReadError::kRead;
+    r.os_errno = ENOMEM;
   }
-  *out = std::move(text);
-  return true;
+  return r;
 }
 
 bool check_output_file(const fs::path& file, std::string* error) {
@@ -207,4 +210,4 @@ bool write_file_atomically(const fs::path& file, const std::string& text, std::s
   return true;
 }
 
-}  // namespace tacse3::config::detail
+}  // namespace tacse3::fileio
