@@ -52,8 +52,10 @@ void BM_DualFramePair(benchmark::State& state) {
   for (auto _ : state) {
     const int cycle = static_cast<int>(i % (2 * f.count));
     const int k = cycle < f.count ? cycle : 2 * f.count - 1 - cycle;
-    const auto l = test::frame_view(f.pad[0][static_cast<std::size_t>(k)], dsp::PixelFormat::kRgb888);
-    const auto r = test::frame_view(f.pad[1][static_cast<std::size_t>(k)], dsp::PixelFormat::kRgb888);
+    const auto l =
+        test::frame_view(f.pad[0][static_cast<std::size_t>(k)], dsp::PixelFormat::kRgb888);
+    const auto r =
+        test::frame_view(f.pad[1][static_cast<std::size_t>(k)], dsp::PixelFormat::kRgb888);
     p->process(&l, &r, i * 8'333'333, out);
     benchmark::DoNotOptimize(out.twist.data());
     ++i;

@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
   }
   config::BoardConfig board;
   std::string e;
-  if (!config::load_board(std::filesystem::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml", &board, &e)) {
+  if (!config::load_board(std::filesystem::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml",
+                          &board, &e)) {
     std::fprintf(stderr, "tacse3_bench_latency: %s\n", e.c_str());
     return 1;
   }

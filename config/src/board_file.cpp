@@ -2,8 +2,8 @@
 // tacse3 config: board file reader (toml++, no exceptions) with every key validated and named.
 #include "tacse3/config/board_file.hpp"
 
-// Header-only toml++ without exceptions, as in calibration_file.cpp: a bad board file must come back as a
-// message, never as an exception or an assert. Only this translation unit includes toml++.
+// Header-only toml++ without exceptions, as in calibration_file.cpp: a bad board file must come
+// back as a message, never as an exception or an assert. No header of config/ exposes toml++.
 #define TOML_HEADER_ONLY 1
 #define TOML_EXCEPTIONS 0
 #define TOML_ENABLE_FORMATTERS 0
@@ -289,11 +289,11 @@ void read_gpio_line(Reader& rd, const toml::table& parent, const char* key, Gpio
   rd.boolean(*t, "active_low", path, &l.active_low);
   if (input) {
     rd.choice<GpioBias>(*t, "bias", path,
-                             {{"as-is", GpioBias::kAsIs},
-                              {"disable", GpioBias::kDisable},
-                              {"pull-up", GpioBias::kPullUp},
-                              {"pull-down", GpioBias::kPullDown}},
-                             &l.bias);
+                        {{"as-is", GpioBias::kAsIs},
+                         {"disable", GpioBias::kDisable},
+                         {"pull-up", GpioBias::kPullUp},
+                         {"pull-down", GpioBias::kPullDown}},
+                        &l.bias);
     rd.integer(*t, "debounce_ms", path, 0, 1000, &g->debounce_ms);
   }
   if (rd.ok() && l.offset < 0 && l.name.empty()) {

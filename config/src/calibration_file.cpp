@@ -3,7 +3,7 @@
 #include "tacse3/config/calibration_file.hpp"
 
 // Header-only toml++ without exceptions: parse errors come back as values, so nothing can escape
-// from a SIGHUP reload. Only this translation unit includes toml++.
+// from a SIGHUP reload. No header of config/ exposes toml++.
 #define TOML_HEADER_ONLY 1
 #define TOML_EXCEPTIONS 0
 #define TOML_ENABLE_FORMATTERS 0
@@ -28,7 +28,8 @@ namespace {
 
 using dsp::Calibration;
 
-// The schema (keys, members, ranges, rules) is dsp's: dsp/include/tacse3/dsp/calibration_fields.hpp.
+// The schema (keys, members, ranges, rules) is dsp's:
+// dsp/include/tacse3/dsp/calibration_fields.hpp.
 using Field = dsp::CalibrationField;
 using Kind = dsp::CalibrationField::Kind;
 constexpr const auto& kFields = dsp::kCalibrationFields;

@@ -306,8 +306,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // Ω is a drag and Ω and the anchor still share enough cells, else Ω. The ratio test compares
   // two parts in the same units (strict, so a shear-free frame reads Ω); the overlap test is in
   // double, exact for cell counts.
-  const bool drag = shear_content.tail<2>().norm() >
-                    kVelocityAnchorDragRatio * std::abs(shear_content.x());
+  const bool drag =
+      shear_content.tail<2>().norm() > kVelocityAnchorDragRatio * std::abs(shear_content.x());
   const auto smaller_set = static_cast<double>(std::min(anchor_count_, m.n));
   out.velocity_anchored =
       drag && mh.n > 0 && static_cast<double>(mh.n) >= kVelocityAnchorMinOverlap * smaller_set;
@@ -549,8 +549,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // is held.
   if (m.n == 0) {
     have_anchor_ = false;
-  } else if (!have_anchor_ || slide_ended ||
-             shear_content.norm() <= min_shift_m_) {
+  } else if (!have_anchor_ || slide_ended || shear_content.norm() <= min_shift_m_) {
     anchor_mask_ = contact.mask;
     anchor_count_ = m.n;
     have_anchor_ = true;

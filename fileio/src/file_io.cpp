@@ -76,8 +76,8 @@ bool create_temporary(const fs::path& file, OwnedFile* tmp, std::string* error) 
   static std::atomic<unsigned> counter{0};
   const fs::path dir = directory_of(file);
   for (int attempt = 0; attempt < 100; ++attempt) {
-    const std::string name = "." + file.filename().string() + ".tmp-" +
-                             std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    const std::string name = "." + file.filename().string() + ".tmp-" + std::to_string(::getpid()) +
+                             "-" + std::to_string(counter++);
     const std::string path = (dir / name).string();
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0666);
     if (fd >= 0) {
@@ -93,7 +93,9 @@ bool create_temporary(const fs::path& file, OwnedFile* tmp, std::string* error) 
 
 }  // namespace
 
-std::string os_error(int err) { return std::string(" (") + std::strerror(err) + ")"; }
+std::string os_error(int err) {
+  return std::string(" (") + std::strerror(err) + ")";
+}
 
 std::string size_text(std::size_t bytes) {
   if (bytes % (1u << 20) == 0) return std::to_string(bytes >> 20) + " MiB";
@@ -162,9 +164,10 @@ bool check_output_file(const fs::path& file, std::string* error) {
   }
   const fs::path dir = directory_of(file);
   if (::stat(dir.c_str(), &st) != 0) {
-    *error = errno == ENOENT ? name + ": the directory " + dir.string() +
-                                   " does not exist; create it or give another path"
-                             : name + ": cannot check the directory " + dir.string() + os_error(errno);
+    *error = errno == ENOENT
+                 ? name + ": the directory " + dir.string() +
+                       " does not exist; create it or give another path"
+                 : name + ": cannot check the directory " + dir.string() + os_error(errno);
     return false;
   }
   if (!S_ISDIR(st.st_mode)) {

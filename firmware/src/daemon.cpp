@@ -266,7 +266,7 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
 
   // GPIO.
   d->gpio_ = board.gpio.backend == config::GpioBackendKind::kLibgpiod ? hal::make_libgpiod_gpio()
-                                                              : hal::make_null_gpio();
+                                                                      : hal::make_null_gpio();
   hal::GpioConfig gc = board.gpio.lines;
   gc.consumer = "tacse3d";
   if (const hal::GpioStatus st = d->gpio_->open(gc); !st.ok()) {
@@ -302,7 +302,8 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
   if (!options.record_dir.empty()) {
 #if TACSE3_HAVE_RECORDER
     RecorderConfig rc;
-    const config::SensorBoardConfig& s0 = board.sensors[0].enabled ? board.sensors[0] : board.sensors[1];
+    const config::SensorBoardConfig& s0 =
+        board.sensors[0].enabled ? board.sensors[0] : board.sensors[1];
     rc.width = s0.width;
     rc.height = s0.height;
     rc.fps = s0.fps;

@@ -224,8 +224,7 @@ TEST(CalibrationFile, LoadRefusesAFifoOrADeviceAtOnce) {
   EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
   const cfg::Status d = load_with_deadline("/dev/null");
   ASSERT_FALSE(d.ok());
-  EXPECT_NE(d.message().find("/dev/null: is a character device"), std::string::npos)
-      << d.message();
+  EXPECT_NE(d.message().find("/dev/null: is a character device"), std::string::npos) << d.message();
   // A sparse file just over the bound is refused by its size, without reading it.
   const fs::path big = s.dir / "big.toml";
   std::ofstream(big) << kHead;
@@ -291,9 +290,9 @@ TEST(CalibrationFile, OutputCheckNamesAMissingOrUnwritableDirectory) {
   const fs::path missing = s.dir / "no-such-dir" / "cal.toml";
   const cfg::Status m = cfg::check_calibration_output(missing);
   ASSERT_FALSE(m.ok());
-  EXPECT_NE(m.message().find("the directory " + (s.dir / "no-such-dir").string() +
-                             " does not exist"),
-            std::string::npos)
+  EXPECT_NE(
+      m.message().find("the directory " + (s.dir / "no-such-dir").string() + " does not exist"),
+      std::string::npos)
       << m.message();
   EXPECT_FALSE(cfg::save_calibration(missing, odd_set()).ok());
   EXPECT_TRUE(cfg::check_calibration_output(s.dir / "new.toml").ok());

@@ -742,9 +742,10 @@ TEST(BlockFlowReference, FollowsTheGivenDecisions) {
     strict_overruled = n;
     strict_worst_rms = std::max(strict_worst_rms, std::sqrt(sum / std::max(n, 1)));
   }
-  std::printf("  strict reference: %d of the fixed path's points overrule its own texture test, "
-              "their worst rms %.4f px\n",
-              strict_overruled, strict_worst_rms);
+  std::printf(
+      "  strict reference: %d of the fixed path's points overrule its own texture test, "
+      "their worst rms %.4f px\n",
+      strict_overruled, strict_worst_rms);
   EXPECT_GT(strict_overruled, kGridCount / 8);
   EXPECT_LE(strict_worst_rms, 0.25);
   EXPECT_GE(fixed_switches, 3);

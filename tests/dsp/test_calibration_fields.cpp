@@ -64,7 +64,7 @@ void set_value(const CalibrationField& f, Calibration& c, double v) {
 // moved out of the way), so only the field's own range decides.
 Calibration free_of_rules() {
   Calibration c;
-  c.contact_tau_on = 1e4;             // contact_tau_off may take its whole range
+  c.contact_tau_on = 1e4;                 // contact_tau_off may take its whole range
   c.release_load_rate = kReleaseRuleOff;  // slip_smoothing_s may take its whole range
   return c;
 }
@@ -81,8 +81,7 @@ TEST(CalibrationFields, ValidateHonoursEachBoundAsStated) {
       if (&f == find_calibration_field("release_load_rate")) c.slip_smoothing_s = 0.0;
       EXPECT_EQ(validate(c) == Status::kOk, !open) << f.key << (low ? " at lo" : " at hi");
       // Just outside the bound (one integer step, or a relative nudge for reals).
-      const double step = f.kind == Kind::kInt ? 1.0
-                                               : std::max(std::abs(bound) * 1e-9, 1e-300);
+      const double step = f.kind == Kind::kInt ? 1.0 : std::max(std::abs(bound) * 1e-9, 1e-300);
       set_value(f, c, low ? bound - step : bound + step);
       EXPECT_EQ(validate(c), Status::kBadCalibration) << f.key << (low ? " below lo" : " above hi");
       set_value(f, c, std::nan(""));

@@ -348,11 +348,14 @@ TEST(Motion, DisplacementIncrementsOnlyFromCellsInBothMasks) {
   const GridMask before = run.cs->mask;
   // The ring that enters Ω this frame carries a stale shear 20 times the true increment.
   auto stale = std::make_unique<VectorField>(fl.shear_now);
-  run.det->detect(fl.fz, fl.w_now, [] {
-    GridMask v;
-    v.fill(1);
-    return v;
-  }(), *run.cs);
+  run.det->detect(
+      fl.fz, fl.w_now,
+      [] {
+        GridMask v;
+        v.fill(1);
+        return v;
+      }(),
+      *run.cs);
   int entering = 0, both = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
     if (run.cs->mask.v[i] == 0) continue;

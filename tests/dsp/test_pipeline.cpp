@@ -89,7 +89,9 @@ RunResult run_reference(const Rendered& r, const DualConfig& cfg,
 }
 
 // Rotation vector of a pose (rad).
-Eigen::Vector3d rotation_vector(const Pose& T) { return so3_log(T.q); }
+Eigen::Vector3d rotation_vector(const Pose& T) {
+  return so3_log(T.q);
+}
 
 // SNR (dB) of `test` against `ref` over the angular part of a twist sequence.
 double omega_snr_db(const std::vector<Vector6d>& ref, const std::vector<Vector6d>& test) {
@@ -166,11 +168,12 @@ TEST_P(FixedVsReference, TwistAndFinalPoseAgree) {
   const RunResult fx = run_fixed(r, cfg, cal, c.left_only);
   const RunResult ref = run_reference(r, cfg, cal, c.left_only);
   const Eigen::Vector3d a = rotation_vector(fx.pose), b = rotation_vector(ref.pose);
-  std::printf("%s: fixed (%.4f %.4f %.4f) deg, reference (%.4f %.4f %.4f) deg, omega SNR %.1f dB, "
-              "RMS omega diff %.2e rad/s, position diff %.2e m\n",
-              c.name, a.x() / kDeg, a.y() / kDeg, a.z() / kDeg, b.x() / kDeg, b.y() / kDeg,
-              b.z() / kDeg, omega_snr_db(ref.twist, fx.twist),
-              rms_omega_difference(ref.twist, fx.twist), (fx.pose.p - ref.pose.p).norm());
+  std::printf(
+      "%s: fixed (%.4f %.4f %.4f) deg, reference (%.4f %.4f %.4f) deg, omega SNR %.1f dB, "
+      "RMS omega diff %.2e rad/s, position diff %.2e m\n",
+      c.name, a.x() / kDeg, a.y() / kDeg, a.z() / kDeg, b.x() / kDeg, b.y() / kDeg, b.z() / kDeg,
+      omega_snr_db(ref.twist, fx.twist), rms_omega_difference(ref.twist, fx.twist),
+      (fx.pose.p - ref.pose.p).norm());
   EXPECT_LT((a - b).norm() / kDeg, 0.1 + 0.01 * b.norm() / kDeg);
   if (c.left_only && c.method == FusionMethod::kJoint) {
     // One pad: both read only the rotation about the pad normal (dsp/fusion.cpp).
@@ -189,19 +192,18 @@ TEST_P(FixedVsReference, TwistAndFinalPoseAgree) {
 
 INSTANTIATE_TEST_SUITE_P(
     Scenes, FixedVsReference,
-    ::testing::Values(
-        AgreementCase{"rz3_joint_displacement", rotation_about_z, FusionMethod::kJoint,
-                      VelocityProxy::kDisplacement},
-        AgreementCase{"rz3_paper_velocity", rotation_about_z, FusionMethod::kPaper,
-                      VelocityProxy::kVelocity},
-        AgreementCase{"rx1.5_joint_velocity", rotation_about_x, FusionMethod::kJoint,
-                      VelocityProxy::kVelocity},
-        AgreementCase{"ty0.4_paper_displacement", translation_along_y, FusionMethod::kPaper,
-                      VelocityProxy::kDisplacement},
-        AgreementCase{"rz3_joint_displacement_left_only", rotation_about_z, FusionMethod::kJoint,
-                      VelocityProxy::kDisplacement, true},
-        AgreementCase{"rx1.5_joint_velocity_left_only", rotation_about_x, FusionMethod::kJoint,
-                      VelocityProxy::kVelocity, true}),
+    ::testing::Values(AgreementCase{"rz3_joint_displacement", rotation_about_z,
+                                    FusionMethod::kJoint, VelocityProxy::kDisplacement},
+                      AgreementCase{"rz3_paper_velocity", rotation_about_z, FusionMethod::kPaper,
+                                    VelocityProxy::kVelocity},
+                      AgreementCase{"rx1.5_joint_velocity", rotation_about_x, FusionMethod::kJoint,
+                                    VelocityProxy::kVelocity},
+                      AgreementCase{"ty0.4_paper_displacement", translation_along_y,
+                                    FusionMethod::kPaper, VelocityProxy::kDisplacement},
+                      AgreementCase{"rz3_joint_displacement_left_only", rotation_about_z,
+                                    FusionMethod::kJoint, VelocityProxy::kDisplacement, true},
+                      AgreementCase{"rx1.5_joint_velocity_left_only", rotation_about_x,
+                                    FusionMethod::kJoint, VelocityProxy::kVelocity, true}),
     [](const ::testing::TestParamInfo<AgreementCase>& i) {
       std::string n = i.param.name;
       for (char& ch : n) {

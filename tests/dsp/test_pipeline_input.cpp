@@ -27,8 +27,10 @@ class PipelineInput : public ::testing::Test {
     }
   }
   DualResult step(int f, const FrameView* override_right = nullptr) {
-    const FrameView l = test::frame_view(frames[0][static_cast<std::size_t>(f)], PixelFormat::kRgb888);
-    const FrameView r = test::frame_view(frames[1][static_cast<std::size_t>(f)], PixelFormat::kRgb888);
+    const FrameView l =
+        test::frame_view(frames[0][static_cast<std::size_t>(f)], PixelFormat::kRgb888);
+    const FrameView r =
+        test::frame_view(frames[1][static_cast<std::size_t>(f)], PixelFormat::kRgb888);
     DualResult out;
     pipeline->process(&l, override_right ? override_right : &r, t_ns, out);
     t_ns += 8'333'333;
@@ -51,11 +53,12 @@ TEST_F(PipelineInput, WrongFrameSizeIsAClearErrorAndChangesNothing) {
   EXPECT_TRUE(r.sensors[0].processed);
   EXPECT_TRUE(r.single_sensor || !r.fused.contact[1]);
   // A truncated buffer of the right nominal size is rejected too.
-  FrameView truncated{frames[1][0].data(), frames[1][0].size() - 1, 320, 240, 0, PixelFormat::kRgb888};
+  FrameView truncated{frames[1][0].data(), frames[1][0].size() - 1, 320, 240, 0,
+                      PixelFormat::kRgb888};
   EXPECT_EQ(step(7, &truncated).sensors[1].status, Status::kBadFrameSize);
   FrameView null_data{nullptr, 0, 320, 240, 0, PixelFormat::kRgb888};
   EXPECT_EQ(step(8, &null_data).sensors[1].status, Status::kNullFrame);
-  FrameView bad_format{frames[1][0].data(), frames[1][0].size(), 320, 240, 0,
+  FrameView bad_format{frames[1][0].data(),        frames[1][0].size(), 320, 240, 0,
                        static_cast<PixelFormat>(9)};
   EXPECT_EQ(step(9, &bad_format).sensors[1].status, Status::kBadPixelFormat);
   EXPECT_TRUE(pipeline->pose().q.coeffs().allFinite());

@@ -156,8 +156,8 @@ TEST(SlipPayback, MatchesTheReferenceOnRandomSequences) {
       f.confirmed = rare(rng);
       if (!f.differs) f.velocity = f.chosen;
       const Vector6d a = p.update(f, kDt);
-      const Vector6d b = r.update(f.chosen, f.velocity, f.differs, f.contact, f.onset, f.confirmed,
-                                  false, kDt);
+      const Vector6d b =
+          r.update(f.chosen, f.velocity, f.differs, f.contact, f.onset, f.confirmed, false, kDt);
       ASSERT_LT((a - b).cwiseAbs().maxCoeff(), 1e-9) << "trial " << trial << " frame " << frame;
     }
   }

@@ -44,11 +44,12 @@ TEST(ZeroAllocation, ThousandDualFramesAfterInit) {
   for (int i = 0; i < 1000; ++i) {
     const int cycle = i % (2 * n);
     const int f = cycle < n ? cycle : 2 * n - 1 - cycle;  // forwards, then backwards
-    const FrameView l = test::frame_view(frames[0][static_cast<std::size_t>(f)], PixelFormat::kRgb888);
+    const FrameView l =
+        test::frame_view(frames[0][static_cast<std::size_t>(f)], PixelFormat::kRgb888);
     FrameView r = test::frame_view(frames[1][static_cast<std::size_t>(f)], PixelFormat::kRgb888);
     if (i % 97 == 50) r = test::frame_view(dark, PixelFormat::kRgb888);  // dark frame
     if (i % 131 == 70) r = test::frame_view(yuyv, PixelFormat::kYuyv);   // format change
-    const bool drop_right = i % 173 == 100;                             // missed cycle
+    const bool drop_right = i % 173 == 100;                              // missed cycle
     pipeline->process(&l, drop_right ? nullptr : &r, std::int64_t{i} * 8'333'333, result);
     if (i == 400) pipeline->tare();
     if (i == 600) pipeline->reset_pose();

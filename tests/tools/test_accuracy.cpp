@@ -267,10 +267,9 @@ TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
 TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
-  const std::vector<tt::SimCase> cases = {sim_case("sphere", "rz", 3, 3, 15),
-                                          sim_case("sphere", "ry", 2, 3, 12),
-                                          sim_case("sphere", "rz", 3, 4, 0, 1.5),
-                                          sim_case("screwdriver", "rx", 2, 2, 0)};
+  const std::vector<tt::SimCase> cases = {
+      sim_case("sphere", "rz", 3, 3, 15), sim_case("sphere", "ry", 2, 3, 12),
+      sim_case("sphere", "rz", 3, 4, 0, 1.5), sim_case("screwdriver", "rx", 2, 2, 0)};
   const std::vector<tt::EvalConfig> cfg = {
       {tacse3::dsp::FusionMethod::kJoint, tt::ProxyMode::kAuto, tt::SensorChoice::kBoth, false}};
   for (const tt::SimCase& c : cases) {
@@ -279,10 +278,11 @@ TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
     ASSERT_TRUE(err.empty()) << err;
     const auto& e = res[0].errors;
     const tt::SlipScore& sl = res[0].slip;
-    std::printf("%-40s rotation error %.2f deg (estimated %.2f), %lld sensor-frames called "
-                "slipping\n",
-                c.sim_arguments().c_str(), e.final_rotation_error_deg, e.estimated_rotation_deg,
-                static_cast<long long>(sl.false_slip + sl.true_slip));
+    std::printf(
+        "%-40s rotation error %.2f deg (estimated %.2f), %lld sensor-frames called "
+        "slipping\n",
+        c.sim_arguments().c_str(), e.final_rotation_error_deg, e.estimated_rotation_deg,
+        static_cast<long long>(sl.false_slip + sl.true_slip));
     ASSERT_TRUE(res[0].slip_scored);
     // A false onset keeps the contact "slipping" for the rest of the run (hundreds of
     // sensor-frames); a few frames would be a near miss of the thresholds, not that failure.
@@ -338,10 +338,11 @@ TEST(Accuracy, TheGraspOfAnOffCentreContactIsNotPaidBackAsASlide) {
       }
       const tt::PoseErrors e = tt::pose_errors(poses, info.truth, info.t_ns);
       const tt::PoseErrors ev = tt::pose_errors(velocity_poses, info.truth, info.t_ns);
-      std::printf("sphere %s 10 mm, seed 3, area bound %s: the velocity reading moved %.3f mm "
-                  "during the grasp and ends %.3f mm off; auto ends %.3f mm off (%.2f deg)\n",
-                  axis, area_bound ? "on" : "off", grasp_drift_mm, ev.final_translation_error_mm,
-                  e.final_translation_error_mm, e.final_rotation_error_deg);
+      std::printf(
+          "sphere %s 10 mm, seed 3, area bound %s: the velocity reading moved %.3f mm "
+          "during the grasp and ends %.3f mm off; auto ends %.3f mm off (%.2f deg)\n",
+          axis, area_bound ? "on" : "off", grasp_drift_mm, ev.final_translation_error_mm,
+          e.final_translation_error_mm, e.final_rotation_error_deg);
       if (area_bound) {
         // The forming mask's centroid jumps are read from the material points.
         EXPECT_LT(grasp_drift_mm, 0.05) << axis;
@@ -402,10 +403,11 @@ TEST(Accuracy, TheFlowTracksThePressedGelEverywhere) {
     }
   }
   for (std::size_t k = 0; k < flows.size(); ++k) {
-    std::printf("sphere rz 30, %s pad, max_residual_ratio %.2f: at most %d of %d flow points "
-                "untracked at rest after the grasp, %d during the torsion and the hold\n",
-                k < 2 ? "left" : "right", flows[k]->config().max_residual_ratio, worst_rest[k],
-                tacse3::dsp::kGridCount, worst_moving[k]);
+    std::printf(
+        "sphere rz 30, %s pad, max_residual_ratio %.2f: at most %d of %d flow points "
+        "untracked at rest after the grasp, %d during the torsion and the hold\n",
+        k < 2 ? "left" : "right", flows[k]->config().max_residual_ratio, worst_rest[k],
+        tacse3::dsp::kGridCount, worst_moving[k]);
   }
   for (std::size_t k = 0; k < flows.size(); k += 2) {
     EXPECT_LE(worst_rest[k], tacse3::dsp::kGridCount / 100) << "pad " << k / 2;
@@ -430,9 +432,8 @@ TEST(Accuracy, AFlatFaceFirstSeenAtACornerIsNotReadAsATranslation) {
   for (auto& s : off.sensor) s.max_mask_area_ratio = 1e4;
   const tt::PoseErrors on_e = replay_errors(c, committed);
   const tt::PoseErrors off_e = replay_errors(c, off);
-  std::printf("%s: error %.2f mm with the area bound, %.2f mm without\n",
-              c.sim_arguments().c_str(), on_e.final_translation_error_mm,
-              off_e.final_translation_error_mm);
+  std::printf("%s: error %.2f mm with the area bound, %.2f mm without\n", c.sim_arguments().c_str(),
+              on_e.final_translation_error_mm, off_e.final_translation_error_mm);
   EXPECT_LT(on_e.final_translation_error_mm, 1.0);
   EXPECT_GT(off_e.final_translation_error_mm, 5.0);
 }
@@ -447,8 +448,8 @@ TEST(Accuracy, AFlatFaceFirstSeenAtACornerIsNotReadAsATranslation) {
 TEST(Accuracy, AChainThatTookAWrongMatchIsReanchoredToTheTare) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
-  for (const tt::SimCase& c : {sim_case("screwdriver", "tx", 10.0, 2, 0.0),
-                               sim_case("sphere", "tx", 10.0, 4, 0.0, 2.0)}) {
+  for (const tt::SimCase& c :
+       {sim_case("screwdriver", "tx", 10.0, 2, 0.0), sim_case("sphere", "tx", 10.0, 4, 0.0, 2.0)}) {
     const tt::PoseErrors e = replay_errors(c, cal);
     std::printf("%s: translation %.2f mm for 10 mm, error %.2f mm (rotation drift %.2f deg)\n",
                 c.sim_arguments().c_str(), e.estimated_translation_mm, e.final_translation_error_mm,
@@ -564,8 +565,8 @@ TEST(Accuracy, TheVelocityProxyReadsAnInPlaneSlideAtAnySpeed) {
         replay_errors(c, cal, tt::ProxyMode::kVelocity,
                       [&](tacse3::sim::SimConfig& sc) { sc.scenario.motion_s = motion_s[k]; });
     read[k] = e.estimated_rotation_deg;
-    std::printf("sphere rx 30 deg in %.1f s, friction 5, --mode velocity: %.2f deg\n",
-                motion_s[k], read[k]);
+    std::printf("sphere rx 30 deg in %.1f s, friction 5, --mode velocity: %.2f deg\n", motion_s[k],
+                read[k]);
   }
   ASSERT_GT(read[1], 15.0);
   EXPECT_NEAR(read[0] / read[1], 1.0, 0.03);

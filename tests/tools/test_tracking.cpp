@@ -19,12 +19,18 @@ constexpr int kRate = 120;
 constexpr int kFrames = 240;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-std::int64_t t_of(int i) { return static_cast<std::int64_t>(i) * 1000000000 / kRate; }
+std::int64_t t_of(int i) {
+  return static_cast<std::int64_t>(i) * 1000000000 / kRate;
+}
 
 // Rest for 0.5 s, 60 deg/s about z for 1 s, then a hold at 60 deg (angles in degrees).
-double angle_at(double t_s) { return 60.0 * std::clamp(t_s - 0.5, 0.0, 1.0); }
+double angle_at(double t_s) {
+  return 60.0 * std::clamp(t_s - 0.5, 0.0, 1.0);
+}
 // 10 mm/s along x over the same second (mm).
-double x_at(double t_s) { return 10.0 * std::clamp(t_s - 0.5, 0.0, 1.0); }
+double x_at(double t_s) {
+  return 10.0 * std::clamp(t_s - 0.5, 0.0, 1.0);
+}
 
 tacse3::dsp::Pose pose(double angle_deg, double x_mm) {
   tacse3::dsp::Pose p;

@@ -199,8 +199,8 @@ int main(int argc, char** argv) {
       for (std::size_t l = 0; l < kLockLevels.size(); ++l) {
         const auto& follow = r.followers[l].take(r.engine.pipeline(), fres);
         ref::DualResultRef lo;
-        r.locked[l]->process(use[0] ? views[0] : nullptr, use[1] ? views[1] : nullptr,
-                             info.t_ns[i], lo, &follow);
+        r.locked[l]->process(use[0] ? views[0] : nullptr, use[1] ? views[1] : nullptr, info.t_ns[i],
+                             lo, &follow);
         r.locked_poses[l].push_back(lo.pose);
       }
       for (int s = 0; s < 2; ++s) {
@@ -399,7 +399,8 @@ int main(int argc, char** argv) {
       std::printf(
           "  locked %-10s %10.4f  (reference following the fixed pipeline's %s decisions; "
           "ref err %.3f)\n",
-          kLockLevels[l].first, tt::rotation_error_deg(r.poses.back().q, r.locked_poses[l].back().q),
+          kLockLevels[l].first,
+          tt::rotation_error_deg(r.poses.back().q, r.locked_poses[l].back().q),
           kLockLevels[l].first,
           tt::pose_errors(r.locked_poses[l], info.truth, info.t_ns).final_rotation_error_deg);
     }

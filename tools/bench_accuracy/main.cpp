@@ -372,7 +372,8 @@ int run(int argc, char** argv) {
   add("Errors are final-pose errors of one simulated trial per row (test set: seed 1, preset "
       "sizes, indentation 1 mm). `tracking`: the per-frame rotation error from the motion's "
       "start to the end, RMS / max, with the truth delayed by the lag (0-50 ms, whole frames, "
-      "in brackets) that gives the lowest RMS (dual, joint, auto). `fixed−ref`: angle between the final orientations of the "
+      "in brackets) that gives the lowest RMS (dual, joint, auto). `fixed−ref`: angle between the "
+      "final orientations of the "
       "fixed-point pipeline and the double-precision reference (dsp_ref::DualPipelineRef), both "
       "in the default configuration (dual, joint, auto), with the reference's own error; "
       "`locked`: the same against a reference that takes the fixed pipeline's per-frame "
@@ -380,12 +381,14 @@ int run(int argc, char** argv) {
       "switches with their re-anchored and lost points, the contact mask and the stick/slip "
       "decision) and computes the rest in double, "
       "i.e. the fixed-point arithmetic's difference apart from a few per-point choices the "
-      "reference still makes itself (docs/dsp/reference.md). The free-running figure adds the threshold "
+      "reference still makes itself (docs/dsp/reference.md). The free-running figure adds the "
+      "threshold "
       "crossings where the two arithmetics decide differently.");
   add("");
   add("### Table V-B: grasped sphere, mean angular error (deg)");
   add("");
-  add("| axis | angle | paper | ours joint | ours paper | goal | tracking (deg) | fixed−ref (deg) |");
+  add("| axis | angle | paper | ours joint | ours paper | goal | tracking (deg) | fixed−ref (deg) "
+      "|");
   add("|---|---|---|---|---|---|---|---|");
   for (const auto& r : rows) {
     if (!r.vb) continue;
@@ -563,8 +566,7 @@ int run(int argc, char** argv) {
     goal_row("rotation drift under 10 mm translation (deg)", 0.5, drift, any_t);
     goal_row("translation error, 10 mm translations (mm)", 0.2, trans, any_t);
     goal_row("stick-regime rotation error (deg)", 0.2, stick, any_s);
-    goal_row("fixed-point vs double reference taking the same decisions (deg)", 0.2, locked,
-             any_l);
+    goal_row("fixed-point vs double reference taking the same decisions (deg)", 0.2, locked, any_l);
     goal_row("fixed-point vs free-running double reference (deg)", 0.2, ref, any_r);
   }
   if (cal_in.empty()) {

@@ -28,7 +28,8 @@ std::string range(const CalibrationField& f) {
     return s;
   }
   if (f.kind == Kind::kInt) return "[" + num(f.lo) + ", " + num(f.hi) + "]";
-  return std::string(f.lo_open ? "(" : "[") + num(f.lo) + ", " + num(f.hi) + (f.hi_open ? ")" : "]");
+  return std::string(f.lo_open ? "(" : "[") + num(f.lo) + ", " + num(f.hi) +
+         (f.hi_open ? ")" : "]");
 }
 
 std::string default_value(const CalibrationField& f) {
@@ -73,8 +74,9 @@ int main(int argc, char** argv) {
     return std::ferror(stdout) || std::fflush(stdout) != 0 ? 1 : 0;
   }
   if (argc == 2 && std::strcmp(argv[1], "--help") == 0) {
-    std::puts("Usage: tacse3-calkeys --markdown\n"
-              "Prints the calibration key table of docs/calibration.md from the dsp schema.");
+    std::puts(
+        "Usage: tacse3-calkeys --markdown\n"
+        "Prints the calibration key table of docs/calibration.md from the dsp schema.");
     return 0;
   }
   std::fputs("usage: tacse3-calkeys --markdown (see --help)\n", stderr);

@@ -16,7 +16,9 @@ using namespace tacse3;
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-Eigen::Vector3d rotation_vector(const Eigen::Quaterniond& q) { return dsp::so3_log(q); }
+Eigen::Vector3d rotation_vector(const Eigen::Quaterniond& q) {
+  return dsp::so3_log(q);
+}
 
 // One small in-grip rotation (the sticking regime, where the kinematic displacement proxy needs
 // no calibration) about the given axis of the gripper frame.
@@ -65,24 +67,27 @@ int run_case(sim::MotionAxis axis, const char* axis_name, double degrees) {
   const std::int64_t t_end = scenario.frame_time_ns(scenario.frame_count() - 1);
   const Eigen::Vector3d truth = rotation_vector(simulator->truth(t_end).q) * kRadToDeg;
   const Eigen::Vector3d est = rotation_vector(result.pose.q) * kRadToDeg;
-  std::printf("  rotate %4.1f deg about %s: estimated (%6.2f, %6.2f, %6.2f) deg, truth (%6.2f, %6.2f, "
-              "%6.2f) deg, %d of %d frames valid\n",
-              degrees, axis_name, est.x(), est.y(), est.z(), truth.x(), truth.y(), truth.z(), valid,
-              scenario.frame_count());
+  std::printf(
+      "  rotate %4.1f deg about %s: estimated (%6.2f, %6.2f, %6.2f) deg, truth (%6.2f, %6.2f, "
+      "%6.2f) deg, %d of %d frames valid\n",
+      degrees, axis_name, est.x(), est.y(), est.z(), truth.x(), truth.y(), truth.z(), valid,
+      scenario.frame_count());
   return 0;
 }
 
 }  // namespace
 
 int main() {
-  std::printf("tacse3-demo: a 20 mm sphere grasped by two simulated 320x240 DM-Tac pads at 120 fps,\n"
-              "then rotated in the grip (sticking contact). The fixed-point firmware pipeline\n"
-              "estimates the object's rotation in the gripper frame (joint fusion, kinematic\n"
-              "displacement proxy, default calibration):\n");
+  std::printf(
+      "tacse3-demo: a 20 mm sphere grasped by two simulated 320x240 DM-Tac pads at 120 fps,\n"
+      "then rotated in the grip (sticking contact). The fixed-point firmware pipeline\n"
+      "estimates the object's rotation in the gripper frame (joint fusion, kinematic\n"
+      "displacement proxy, default calibration):\n");
   int rc = 0;
   rc |= run_case(sim::MotionAxis::kRz, "z (the pads' normal)", 3.0);
   rc |= run_case(sim::MotionAxis::kRx, "x (along the fingers)", 3.0);
-  std::printf("This runs the default calibration: the axes and signs are right, the magnitudes are\n"
-              "not yet to scale for this simulated gel until tacse3-calibrate fits the gains.\n");
+  std::printf(
+      "This runs the default calibration: the axes and signs are right, the magnitudes are\n"
+      "not yet to scale for this simulated gel until tacse3-calibrate fits the gains.\n");
   return rc;
 }

@@ -221,9 +221,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
       static_cast<double>(held_pts.size()) >=
           dsp::kVelocityAnchorMinOverlap * static_cast<double>(std::min(anchor_count_, out.points));
   out.velocity_anchored =
-      !held_pts.empty() && (release_follow != nullptr && release_follow->has_anchor
-                                ? release_follow->velocity_anchored
-                                : own_rule);
+      !held_pts.empty() &&
+      (release_follow != nullptr && release_follow->has_anchor ? release_follow->velocity_anchored
+                                                               : own_rule);
   if (automatic) {
     if (out.points == 0) {
       reset_detector();

@@ -116,8 +116,7 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
   for (int i = 0; i < 2; ++i) {
     if (frames[i] == nullptr) continue;
     bool degraded = false;
-    const FixedDecisions* f =
-        follow != nullptr ? &(*follow)[static_cast<std::size_t>(i)] : nullptr;
+    const FixedDecisions* f = follow != nullptr ? &(*follow)[static_cast<std::size_t>(i)] : nullptr;
     if (sensors_[static_cast<std::size_t>(i)].process(
             *frames[i], dt, m[static_cast<std::size_t>(i)], degraded, f)) {
       ok[static_cast<std::size_t>(i)] = !degraded;

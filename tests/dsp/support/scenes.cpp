@@ -15,11 +15,13 @@ double smooth_step(double x) {
 
 }  // namespace
 
-int scene_frames(const GraspScene& s) { return s.grasp_frames + s.motion_frames + s.hold_frames; }
+int scene_frames(const GraspScene& s) {
+  return s.grasp_frames + s.motion_frames + s.hold_frames;
+}
 
 dsp::Pose scene_pose(const GraspScene& s, int frame) {
-  const double progress =
-      smooth_step(static_cast<double>(frame - s.grasp_frames) / static_cast<double>(s.motion_frames));
+  const double progress = smooth_step(static_cast<double>(frame - s.grasp_frames) /
+                                      static_cast<double>(s.motion_frames));
   return dsp::se3_exp(s.motion * progress);
 }
 
@@ -46,7 +48,8 @@ std::vector<std::uint8_t> render_scene_frame(const GraspScene& s, const DotTextu
     const Eigen::Vector3d x = dsp::transform_point(T, q);
     const double mi = x.x() / P + 159.5 - i;
     const double mj = ysign * x.y() / P + 119.5 - j;
-    const double weight = r <= R ? 1.0 : std::exp(-(r - R) * (r - R) / (2.0 * s.spread_px * s.spread_px));
+    const double weight =
+        r <= R ? 1.0 : std::exp(-(r - R) * (r - R) / (2.0 * s.spread_px * s.spread_px));
     return {b * dx + weight * mi, b * dy + weight * mj};
   };
   return render_frame(texture, Warp::displacement(u), dsp::PixelFormat::kRgb888, ph);

@@ -20,13 +20,13 @@ namespace tacse3::test {
 // and s is 1 inside the patch and decays smoothly outside it (elastic spreading).
 struct GraspScene {
   double pixel_pitch_m = 0.075e-3;
-  double separation_m = 0.030;        // W, distance between the pad surfaces
-  double patch_radius_px = 36.0;      // contact patch radius, sensor px
-  double spread_px = 14.0;            // decay length of the field outside the patch
-  double bulge_px = 1.2;              // peak radial push-out of the indentation
+  double separation_m = 0.030;                    // W, distance between the pad surfaces
+  double patch_radius_px = 36.0;                  // contact patch radius, sensor px
+  double spread_px = 14.0;                        // decay length of the field outside the patch
+  double bulge_px = 1.2;                          // peak radial push-out of the indentation
   std::array<double, 2> centre_px{159.5, 119.5};  // patch centre on the left pad (image px)
-  int grasp_frames = 8;               // indentation ramps up
-  int motion_frames = 24;             // then the object moves (smooth-step profile)
+  int grasp_frames = 8;                           // indentation ramps up
+  int motion_frames = 24;                         // then the object moves (smooth-step profile)
   int hold_frames = 8;
   dsp::Vector6d motion = dsp::Vector6d::Zero();  // total rigid motion [φ; ρ] of the object in G
   double fps = 120.0;

@@ -81,8 +81,8 @@ enum class GpioBackendKind : std::uint8_t { kNull = 0, kLibgpiod };
 // [gpio]
 struct GpioBoardConfig {
   GpioBackendKind backend = GpioBackendKind::kNull;
-  GpioConfig lines;  // chip + the optional lines (enabled = table present)
-  int debounce_ms = 20;   // [gpio.tare_button].debounce_ms (also used for gripper_closed)
+  GpioConfig lines;      // chip + the optional lines (enabled = table present)
+  int debounce_ms = 20;  // [gpio.tare_button].debounce_ms (also used for gripper_closed)
 };
 
 // [realtime]

@@ -68,7 +68,7 @@ struct FusedMotion {
   bool single_sensor = false;            // exactly one sensor contributed (to ω or t)
   bool rotation_valid = false;
   bool translation_valid = false;
-  bool valid = false;       // rotation_valid && translation_valid
+  bool valid = false;  // rotation_valid && translation_valid
   // rcond of the 3x3 normal equations (min over sensors for kPaper). kJoint with one pad: still
   // the 3x3 system's, although ω then comes from the 1-D solve about the pad normal.
   double confidence = 0.0;

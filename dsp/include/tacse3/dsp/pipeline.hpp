@@ -53,14 +53,14 @@ struct SensorFields {
 
 // Result of one sensor's frame.
 struct SensorResult {
-  Status status = Status::kOk;   // input error (the frame was rejected, state unchanged)
-  bool processed = false;        // the frame went through the pipeline
-  bool degraded = false;         // too few points tracked: motion not used this frame
-  bool reference_taken = false;  // this frame became the (tare) reference
-  int tracked_points = 0;        // valid block-flow points
+  Status status = Status::kOk;          // input error (the frame was rejected, state unchanged)
+  bool processed = false;               // the frame went through the pipeline
+  bool degraded = false;                // too few points tracked: motion not used this frame
+  bool reference_taken = false;         // this frame became the (tare) reference
+  int tracked_points = 0;               // valid block-flow points
   std::uint32_t keyframe_switches = 0;  // since the last tare
   bool keyframe_switched = false;       // this frame became the block flow's next keyframe
-  SensorMotion motion{};  // per-sensor translation, moments and own-frame ω
+  SensorMotion motion{};                // per-sensor translation, moments and own-frame ω
   // kAuto: the stick/slip detector's decision this frame (velocity proxy used); false otherwise.
   bool slipping = false;
 };

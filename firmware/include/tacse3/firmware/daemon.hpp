@@ -9,8 +9,8 @@
 #include <memory>
 #include <string>
 
-#include "tacse3/config/calibration_file.hpp"
 #include "tacse3/config/board_file.hpp"
+#include "tacse3/config/calibration_file.hpp"
 #include "tacse3/firmware/cli.hpp"
 #include "tacse3/firmware/engine.hpp"
 #include "tacse3/hal/can/channel.hpp"

@@ -24,7 +24,7 @@ struct SimCase {
   double radius_mm = 0.0;  // 0 = the preset's size
   double indentation_mm = 1.0;
   double friction = 0.0;  // object-gel friction (tacse3-sim --friction); 0 = the preset's
-  double hold_s = 0.4;  // hold after the motion
+  double hold_s = 0.4;    // hold after the motion
   double approach_s = 0.1, grasp_s = 0.4, settle_s = 0.1;
   double release_s = 0.0;     // pads opening after the hold (0 = none)
   std::string label() const;  // "sphere rz 30"

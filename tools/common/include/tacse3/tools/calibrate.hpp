@@ -34,10 +34,10 @@ struct RecordingFit {
   std::string sim_regime;  // "stick"/"slide" from recording.json's "sim" block: REPORT ONLY
   // Velocity-proxy rate left at rest / rate in motion (-1: not measurable); decides the proxy.
   double rest_persistence = -1.0;
-  double before_deg = 0.0;            // joint, starting calibration, that proxy: rotation error
-  double after_deg = 0.0;             // joint, fitted calibration, that proxy (measured)
-  double after_other_deg = 0.0;       // joint, fitted calibration, the other proxy (measured)
-  double after_paper_deg = 0.0;       // paper fusion, fitted paper scales (linear prediction)
+  double before_deg = 0.0;       // joint, starting calibration, that proxy: rotation error
+  double after_deg = 0.0;        // joint, fitted calibration, that proxy (measured)
+  double after_other_deg = 0.0;  // joint, fitted calibration, the other proxy (measured)
+  double after_paper_deg = 0.0;  // paper fusion, fitted paper scales (linear prediction)
   // joint, fitted (translation scales applied linearly), with the proxy whose translation is
   // closer to the truth (the one the translation scales are fitted on)
   double translation_after_mm = 0.0;

@@ -53,9 +53,9 @@ PoseErrors pose_errors(const std::vector<dsp::Pose>& estimate,
 // between the positions), with the truth delayed by the lag, in whole frame periods from 0 to
 // max_lag_s, that gives the lowest RMS. Rotation and translation each pick their own lag.
 struct TrackingError {
-  bool valid = false;          // there were frames from the motion's start on
-  std::size_t frames = 0;      // frames scored
-  std::int64_t start_ns = 0;   // the motion's start (motion_start_ns)
+  bool valid = false;         // there were frames from the motion's start on
+  std::size_t frames = 0;     // frames scored
+  std::int64_t start_ns = 0;  // the motion's start (motion_start_ns)
   double rotation_rms_deg = 0.0;
   double rotation_max_deg = 0.0;
   double rotation_lag_s = 0.0;
