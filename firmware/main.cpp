@@ -72,8 +72,8 @@ int main(int argc, char** argv) {
   }
 
   // Signals are taken synchronously by the housekeeping loop (sigtimedwait), so they are blocked
-  // in every thread, which inherit this mask. A closed stdout (the reader went away) must not
-  // kill the daemon: the write fails and is counted instead.
+  // in every thread, which inherit this mask. A closed stdout (the reader of --can-log - went
+  // away) must not kill the daemon: the write fails, and the daemon stops with a message, exit 1.
   sigset_t set;
   sigemptyset(&set);
   sigaddset(&set, SIGTERM);

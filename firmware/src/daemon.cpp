@@ -248,6 +248,7 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
       *error = "CAN log " + out + ": " + e;
       return nullptr;
     }
+    d->log_channel_ = ch.get();
     d->channel_ = std::move(ch);
   } else {
     hal::can::SocketCanOptions so;
@@ -477,7 +478,18 @@ void Daemon::rx_loop() {
   }
 }
 
+// The log is the daemon's only CAN output when it is the backend: streaming on without it would
+// look healthy to nobody, so a write error (disk full, reader gone) stops the daemon with exit 1.
+void Daemon::check_can_log() {
+  if (log_channel_ == nullptr || exit_code_ != 0 || !log_channel_->write_failed()) return;
+  exit_code_ = 1;
+  say(0, "%s; stopping (free space or choose another --can-log)",
+      log_channel_->write_error().c_str());
+  stop_.store(true, std::memory_order_release);
+}
+
 void Daemon::housekeeping_tick(std::int64_t now_ns, bool handle_signals) {
+  check_can_log();
 #if TACSE3_HAVE_RECORDER
   // A write error (disk full, directory gone) stops the recording, never the stream.
   if (recorder_ && !recording_failure_reported_ && recorder_->failed()) {
@@ -611,10 +623,11 @@ int Daemon::run(bool handle_signals) {
     }
   }
 #endif
+  check_can_log();  // frames sent during the shutdown
   summary_.streaming_s =
       ready_sent_ ? static_cast<double>(stop_ns - streaming_since_ns_) * 1e-9 : 0.0;
   finish_summary();
-  return 0;
+  return exit_code_;
 }
 
 void Daemon::finish_summary() {

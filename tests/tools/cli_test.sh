@@ -170,6 +170,16 @@ if [ -n "$TACSE3D" ]; then
   done
 fi
 
+# A CAN log that cannot be written (/dev/full: ENOSPC, as a full disk) stops the daemon with exit
+# 1 and one message naming the file and the cause.
+if [ -n "$TACSE3D" ]; then
+  bounded "$TACSE3D" --board sim --seconds 2 --can-log /dev/full > /dev/null 2> "$T/e22"
+  check "tacse3d --can-log /dev/full exits 1" test $? -eq 1
+  check "tacse3d names the CAN log and the cause" \
+    contains "$T/e22" "CAN log /dev/full: write failed: No space left on device"
+  check "the CAN log error is said once" test "$(grep -c 'write failed' "$T/e22")" -eq 1
+fi
+
 # Results on a full standard output are an error, not exit 0.
 "$REPLAY" "$T/rec" --out - > /dev/full 2> "$T/e14"
 check "replay --out - > /dev/full exits 1" test $? -eq 1

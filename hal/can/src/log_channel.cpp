@@ -51,6 +51,7 @@ std::unique_ptr<LogChannel> LogChannel::open(const std::string& input_path,
   auto ch = std::make_unique<LogChannel>(in, out, std::move(iface_name));
   ch->own_in_ = own_in;
   ch->own_out_ = own_out;
+  if (!output_path.empty()) ch->out_name_ = output_path == "-" ? "standard output" : output_path;
   return ch;
 }
 
@@ -91,8 +92,15 @@ bool LogChannel::send(const CanFrame& f) {
     return false;
   }
   line[n] = '\n';
+  if (write_failed_.load(std::memory_order_relaxed)) {
+    tx_errors_.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
   if (std::fwrite(line, 1, n + 1, out_) != n + 1 || std::fflush(out_) != 0) {
-    error_ = std::string("writing the log failed: ") + std::strerror(errno);
+    const int e = errno;
+    error_ = "CAN log " + out_name_ + ": write failed: " + std::strerror(e);
+    write_error_ = error_;
+    write_failed_.store(true, std::memory_order_release);
     tx_errors_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }

@@ -60,6 +60,22 @@ TEST(LogChannel, ReportsMissingFiles) {
   EXPECT_EQ(none.receive(rx, 0), can::RxResult::kEnd);
 }
 
+// /dev/full fails every write with ENOSPC, as a full disk does: the first failure is kept with the
+// file and the cause, and nothing more is written after it.
+TEST(LogChannel, ReportsAWriteErrorWithTheFileAndTheCause) {
+  std::string error;
+  auto ch = can::LogChannel::open("", "/dev/full", error);
+  ASSERT_NE(ch, nullptr) << error;
+  EXPECT_FALSE(ch->write_failed());
+  EXPECT_FALSE(ch->send(tp::CanFrame{}));
+  ASSERT_TRUE(ch->write_failed());
+  EXPECT_EQ(ch->write_error(), "CAN log /dev/full: write failed: No space left on device");
+  EXPECT_FALSE(ch->send(tp::CanFrame{}));
+  EXPECT_EQ(ch->write_error(), "CAN log /dev/full: write failed: No space left on device");
+  EXPECT_EQ(ch->stats().tx_errors, 2u);
+  EXPECT_EQ(ch->stats().tx_frames, 0u);
+}
+
 // This host's kernel has no AF_CAN; on a CAN-capable host the interface does not exist. Either
 // way open() fails with a message that says what is wrong.
 TEST(SocketCan, FailsWithAClearError) {

@@ -16,6 +16,9 @@
 #include "tacse3/hal/can/channel.hpp"
 
 namespace tacse3::hal {
+namespace can {
+class LogChannel;
+}
 class SimRig;
 class SimCamera;
 class GpioBackend;
@@ -62,8 +65,9 @@ class Daemon {
   ~Daemon();
 
   // Runs until request_stop(), a handled signal (SIGTERM/SIGINT stop, SIGHUP reloads the
-  // calibration) or options.seconds of streaming. The caller blocks SIGTERM/SIGINT/SIGHUP in
-  // every thread first (handle_signals) so they are taken here with sigtimedwait.
+  // calibration), options.seconds of streaming or a write error on the CAN log (exit code 1). The
+  // caller blocks SIGTERM/SIGINT/SIGHUP in every thread first (handle_signals) so they are taken
+  // here with sigtimedwait.
   int run(bool handle_signals);
   void request_stop() noexcept { stop_.store(true, std::memory_order_release); }
   // Reload the calibration file now (what SIGHUP does). false + message if the file is bad; the
@@ -85,6 +89,7 @@ class Daemon {
   void dsp_loop();
   void rx_loop();
   void housekeeping_tick(std::int64_t now_ns, bool handle_signals);
+  void check_can_log();
   void finish_summary();
   void say(int level, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
 
@@ -100,6 +105,8 @@ class Daemon {
   // wait for ring space instead of dropping: nothing is lost when the loop is the slower side.
   std::array<bool, 2> backpressure_{};
   std::unique_ptr<hal::can::Channel> channel_;
+  hal::can::LogChannel* log_channel_ = nullptr;  // channel_, when it is the log backend
+  int exit_code_ = 0;
   std::unique_ptr<hal::GpioBackend> gpio_;
   std::unique_ptr<hal::GpioController> gpio_controller_;
   std::unique_ptr<dsp::DualPipeline> pipeline_;

@@ -41,13 +41,22 @@ class LogChannel final : public Channel {
   std::uint64_t bad_lines() const { return bad_lines_; }     // not parseable as candump -L
   std::uint64_t skipped_frames() const { return skipped_; }  // error / remote frames
 
+  // The first write error of the output ("CAN log FILE: write failed: CAUSE"). After it, send()
+  // writes nothing more: a log cut mid-line is worse than one that stops at a line's end. Safe to
+  // call from another thread than send()'s.
+  bool write_failed() const noexcept { return write_failed_.load(std::memory_order_acquire); }
+  const std::string& write_error() const noexcept { return write_error_; }
+
  private:
   std::FILE* in_ = nullptr;
   std::FILE* out_ = nullptr;
   bool own_in_ = false;
   bool own_out_ = false;
   std::string iface_;
+  std::string out_name_ = "the output";  // for messages: the path, or "standard output"
   std::string error_;
+  std::string write_error_;  // set once, before write_failed_
+  std::atomic<bool> write_failed_{false};
   std::function<std::uint64_t()> now_us_;
   std::uint64_t lines_ = 0;
   std::uint64_t bad_lines_ = 0;
