@@ -288,6 +288,13 @@ std::string at_line(const std::string& label, int line_no) {
   return label + " line " + std::to_string(line_no) + ": ";
 }
 
+// A time stamp more than kMaxSpanNs after the file's first one (1e6 s) is refused.
+Status check_span(const std::string& label, int ln, std::int64_t first, std::int64_t t) {
+  if (clamped_difference(t, first) <= kMaxSpanNs) return {};
+  return err(at_line(label, ln) + "t_ns " + std::to_string(t) + " is more than 1e6 s after the " +
+             "first row's " + std::to_string(first) + " (a recording spans at most 1e6 s)");
+}
+
 Status parse_frames(const std::string& text, std::vector<std::int64_t>* t_ns) {
   const std::string label = "frames.csv";
   return parse_csv(text, label, kFramesHeader, 2, [&](int ln, const auto& f) -> Status {
@@ -304,6 +311,9 @@ Status parse_frames(const std::string& text, std::vector<std::int64_t>* t_ns) {
     if (!t_ns->empty() && t <= t_ns->back()) {
       return err(at_line(label, ln) + "t_ns " + std::to_string(t) +
                  " is not after the previous row's " + std::to_string(t_ns->back()));
+    }
+    if (!t_ns->empty()) {
+      if (Status s = check_span(label, ln, t_ns->front(), t); !s) return s;
     }
     t_ns->push_back(t);
     return {};
@@ -332,6 +342,9 @@ Status parse_truth(const std::string& text, std::vector<TruthSample>* out) {
     if (!out->empty() && s.t_ns <= out->back().t_ns) {
       return err(at_line(label, ln) + "t_ns " + std::to_string(s.t_ns) +
                  " is not after the previous row's " + std::to_string(out->back().t_ns));
+    }
+    if (!out->empty()) {
+      if (Status st = check_span(label, ln, out->front().t_ns, s.t_ns); !st) return st;
     }
     out->push_back(s);
     return {};

@@ -352,6 +352,19 @@ TEST(Recording, BadCsvRowsAreNamedWithTheirLine) {
       {"frames.csv", "1,8334333", "1,1000", {"frames.csv line 3", "is not after the previous row"}},
       {"frames.csv", "2,16667666\n", "", {"left/", "frame count mismatch"}},
       {"frames.csv", "1,8334333\n", "\n1,8334333\n", {"frames.csv line 3", "empty line"}},
+      // Spans over kMaxSpanNs (1e6 s), one far enough apart that the difference overflows int64.
+      {"frames.csv",
+       "0,1000\n",
+       "0,-9223372036854775807\n",
+       {"frames.csv line 3", "more than 1e6 s after the first row's -9223372036854775807"}},
+      {"frames.csv",
+       "2,16667666",
+       "2,1000000000001001",
+       {"frames.csv line 4", "a recording spans at most 1e6 s"}},
+      {"truth.csv",
+       "\n16667666,",
+       "\n1000000000001001,",
+       {"truth.csv line 4", "a recording spans at most 1e6 s"}},
       {"truth.csv", "t_ns,qw", "t,qw", {"truth.csv line 1", "header must be"}},
       {"truth.csv", "8334333,", "8334333,x", {"truth.csv line 3", "qw \"x", "not a finite number"}},
       {"truth.csv", "8334333,", "8334333,1,", {"truth.csv line 3", "expected 8 fields, got 9"}},
@@ -391,6 +404,28 @@ Status open_with_deadline(const fs::path& dir, const std::vector<fs::path>& fifo
     ADD_FAILURE() << dir << ": RecordingReader::open blocked";
   }
   return done.get();
+}
+
+// The replay users' arithmetic on time stamps: exact in range, clamped where int64 would overflow
+// (UB that UBSan reports in the host-sanitize build).
+TEST(Recording, ClampedTimeArithmeticNeverOverflows) {
+  EXPECT_EQ(clamped_difference(5, -3), 8);
+  EXPECT_EQ(clamped_difference(INT64_MAX, -1), INT64_MAX);
+  EXPECT_EQ(clamped_difference(INT64_MIN, 1), INT64_MIN);
+  EXPECT_EQ(clamped_difference(INT64_MAX, INT64_MIN), INT64_MAX);
+  EXPECT_EQ(clamped_sum(INT64_MAX - 1, 5), INT64_MAX);
+  EXPECT_EQ(clamped_sum(INT64_MIN + 1, -5), INT64_MIN);
+  EXPECT_EQ(clamped_sum(-4, 6), 2);
+}
+
+// A span of exactly kMaxSpanNs is accepted; the bound is inclusive.
+TEST(Recording, ASpanOfTheBoundIsAccepted) {
+  TempDir tmp;
+  write_valid(tmp.path());
+  replace_in(tmp.path() / "frames.csv", "2,16667666", "2,1000000000001000");
+  auto r = RecordingReader::open(tmp.path());
+  ASSERT_TRUE(r) << r.status().message();
+  EXPECT_EQ(r.value().t_ns(2) - r.value().t_ns(0), kMaxSpanNs);
 }
 
 TEST(Recording, TextFilesThatAreNotRegularFilesAreNamedAtOnce) {

@@ -172,7 +172,9 @@ std::string make_setup(const SourceInfo& info, const ReplayOptions& options, Eng
   if (info.t_ns.size() >= 2) {
     std::vector<std::int64_t> d;
     d.reserve(info.t_ns.size() - 1);
-    for (std::size_t i = 1; i < info.t_ns.size(); ++i) d.push_back(info.t_ns[i] - info.t_ns[i - 1]);
+    // Clamped: a source that is not a checked recording may hold any time stamps.
+    for (std::size_t i = 1; i < info.t_ns.size(); ++i)
+      d.push_back(recording::clamped_difference(info.t_ns[i], info.t_ns[i - 1]));
     std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
     const double p = static_cast<double>(d[d.size() / 2]) * 1e-9;
     if (p >= 1e-4 && p <= 1.0) s.dual.nominal_frame_period_s = p;

@@ -378,7 +378,11 @@ CameraStatus ReplayCamera::next_frame(Frame& frame, int timeout_ms) {
         state_.store(LinkState::kFailed, std::memory_order_release);
         continue;
       }
-      loop_offset_ += t_ns_.back() - t_ns_.front() + nominal_period_ns_;
+      // Clamped sums: the reader bounds a recording's span (1e6 s), but an unpaced loop adds it
+      // up without end.
+      loop_offset_ = rec::clamped_sum(
+          loop_offset_, rec::clamped_sum(rec::clamped_difference(t_ns_.back(), t_ns_.front()),
+                                         nominal_period_ns_));
       next_index_ = 0;
     }
     if (pending_slot_ < 0) {
@@ -405,7 +409,9 @@ CameraStatus ReplayCamera::next_frame(Frame& frame, int timeout_ms) {
       }
       pending_slot_ = slot;
     }
-    const std::int64_t stamp = start_ns_ + loop_offset_ + (t_ns_[next_index_] - t_ns_.front());
+    const std::int64_t stamp =
+        rec::clamped_sum(rec::clamped_sum(start_ns_, loop_offset_),
+                         rec::clamped_difference(t_ns_[next_index_], t_ns_.front()));
     if (cfg_.realtime) {
       const std::int64_t now = monotonic_ns();
       if (now < stamp) {

@@ -26,6 +26,26 @@ inline constexpr const char* kLayoutMirrored = "mirrored";
 inline constexpr std::size_t kMaxJsonBytes = std::size_t{1} << 20;
 inline constexpr std::size_t kMaxCsvBytes = std::size_t{64} << 20;
 
+// The longest span of a recording's time stamps, first row to last, in frames.csv and truth.csv:
+// 1e6 s, far beyond any grasp and far below int64's 9.2e9 s, so that differences of time stamps
+// and the replay camera's loop offsets stay representable. The reader refuses a longer span.
+inline constexpr std::int64_t kMaxSpanNs = 1'000'000'000'000'000;
+
+// later - earlier, clamped to int64's range: the span check itself must not overflow.
+constexpr std::int64_t clamped_difference(std::int64_t later, std::int64_t earlier) noexcept {
+  constexpr std::int64_t kMax = INT64_MAX, kMin = INT64_MIN;
+  if (earlier < 0 && later > kMax + earlier) return kMax;
+  if (earlier > 0 && later < kMin + earlier) return kMin;
+  return later - earlier;
+}
+
+// a + b, clamped to int64's range.
+constexpr std::int64_t clamped_sum(std::int64_t a, std::int64_t b) noexcept {
+  if (b > 0 && a > INT64_MAX - b) return INT64_MAX;
+  if (b < 0 && a < INT64_MIN - b) return INT64_MIN;
+  return a + b;
+}
+
 // Success, or a message that names the file and the key or line at fault. No API of this
 // library throws.
 class Status {
