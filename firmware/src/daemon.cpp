@@ -397,6 +397,7 @@ void Daemon::capture_loop(std::size_t s) {
   const char* side = s == 0 ? "left" : "right";
   std::uint64_t overflow = 0;
   bool reported_error = false;
+  bool reported_bad = false;
   while (!stop_.load(std::memory_order_acquire)) {
     hal::Frame f;
     const hal::CameraStatus st = cam.next_frame(f, kCaptureTimeoutMs);
@@ -405,6 +406,7 @@ void Daemon::capture_loop(std::size_t s) {
         say(1, "sensor %s: streaming again", side);
       sh.disconnected.store(false, std::memory_order_release);
       reported_error = false;
+      reported_bad = false;
       bool queued = ring.push(f);
       while (!queued && backpressure_[s] && !stop_.load(std::memory_order_acquire)) {
         sleep_ns(500'000);  // an unpaced source waits for the loop
@@ -422,11 +424,17 @@ void Daemon::capture_loop(std::size_t s) {
     }
     switch (st.code) {
       case hal::CameraError::kTimeout:
+        break;
       case hal::CameraError::kCorruptFrame:
+        // Dropped and counted by the camera (summed up at the stop). Said once per run of bad
+        // frames: a deleted recording fails every frame with the same cause.
+        if (!reported_bad) say(1, "sensor %s: frame dropped: %s", side, st.message());
+        reported_bad = true;
         break;
       case hal::CameraError::kDisconnected:
-        sh.disconnected.store(true, std::memory_order_release);
-        say(1, "sensor %s lost: %s", side, st.message());
+        // Said when the sensor is lost, not on every retry (an ended recording keeps saying so).
+        if (!sh.disconnected.exchange(true, std::memory_order_acq_rel))
+          say(1, "sensor %s lost: %s", side, st.message());
         break;
       default:
         if (cam.link_state() == hal::LinkState::kDisconnected ||
@@ -606,6 +614,12 @@ int Daemon::run(bool handle_signals) {
   }
   rx.join();
   engine_->release_all();
+  for (std::size_t s = 0; s < 2; ++s) {
+    const std::uint64_t bad = cameras_[s] ? cameras_[s]->stats().corrupt : 0;
+    if (bad > 0)
+      say(1, "sensor %s: %llu bad frame(s) dropped", s == 0 ? "left" : "right",
+          static_cast<unsigned long long>(bad));
+  }
   for (auto& c : cameras_) {
     if (c) c->stop();
   }

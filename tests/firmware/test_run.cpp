@@ -254,6 +254,71 @@ TEST_F(RunTest, ReplayBoardStreamsEveryFramePairOfARecording) {
   EXPECT_EQ(dual, frames) << read_all(dir_ / "err.txt");
   EXPECT_NE(read_all(dir_ / "err.txt").find("end of recording"), std::string::npos);
 }
+
+namespace {
+
+// A short sim recording and a board that replays it on both pads (realtime and repeat as given).
+fs::path replay_board(const fs::path& dir, const char* realtime, const char* repeat) {
+  const fs::path rec = dir / "rec";
+  const RunResult r = run_cmd(std::string(TACSE3_SIM_BIN) + " --out " + rec.string() +
+                              " --motion rz --magnitude 3 --approach-s 0.05 --grasp-s 0.2 "
+                              "--settle-s 0.05 --hold-s 0.1 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  std::string text = read_all(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml");
+  set_key(&text, "repeat", repeat);
+  set_key(&text, "realtime", realtime);
+  for (std::size_t at = 0; (at = text.find("backend = \"sim\"", at)) != std::string::npos;) {
+    const std::string repl = "backend = \"replay\"\ndevice = \"" + rec.string() + "\"";
+    text.replace(at, std::string("backend = \"sim\"").size(), repl);
+    at += repl.size();
+  }
+  std::ofstream(dir / "board.toml") << text;
+  return dir / "board.toml";
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = 0; (at = text.find(what, at)) != std::string::npos; at += what.size()) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_F(RunTest, ReplayBoardReportsABadFrameAndTheEndOnce) {
+  // A truncated PNG is dropped, named with its cause and counted; after the last frame each
+  // sensor says "end of recording" once, not on every retry of its capture loop.
+  const fs::path board = replay_board(dir_, "false", "false");
+  const fs::path png = dir_ / "rec/left/000005.png";
+  fs::resize_file(png, fs::file_size(png) / 2);
+  const RunResult r = run_cmd(std::string(TACSE3D_BIN) + " --board " + board.string() +
+                              " --seconds " + seconds(2) + " --can-log /dev/null 2>&1");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("sensor left: frame dropped: replay camera left: " + png.string()),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("sensor left: 1 bad frame(s) dropped"), std::string::npos) << r.out;
+  EXPECT_EQ(count(r.out, "end of recording"), 2u) << r.out;
+}
+
+TEST_F(RunTest, ReplayBoardSaysWhyARecordingDeletedMidRunFails) {
+  // The recording disappears under a paced, looping replay (moved away: all its files at once):
+  // the frames fail to open, and the log says so (the cause of the FAULT that follows) once per
+  // sensor. The bad frames come at the frame rate, not as fast as open() fails.
+  const fs::path board = replay_board(dir_, "true", "true");
+  const RunResult r =
+      run_cmd("(sleep 1 && mv " + (dir_ / "rec").string() + " " + (dir_ / "gone").string() +
+              ") & " + TACSE3D_BIN + " --board " + board.string() + " --seconds " + seconds(3) +
+              " --can-log /dev/null 2>&1; wait");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(count(r.out, "frame dropped: replay camera"), 2u) << r.out;
+  EXPECT_NE(r.out.find("cannot open: No such file or directory"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("state FAULT"), std::string::npos) << r.out;
+  // At most 120 frames/s per sensor over the run (3 s, times the time scale).
+  const std::size_t bad_at = r.out.find(" bad frame(s) dropped");
+  ASSERT_NE(bad_at, std::string::npos) << r.out;
+  const std::size_t from = r.out.rfind(": ", bad_at) + 2;
+  EXPECT_LE(std::stoul(r.out.substr(from, bad_at - from)), 400u * kTimeScale) << r.out;
+}
 #endif
 
 #if TACSE3_HAVE_RECORDER

@@ -162,6 +162,10 @@ class ReplayCamera final : public Camera {
   std::int64_t start_ns_ = 0;
   std::uint32_t seq_ = 0;
   int pending_slot_ = -1;  // decoded, waiting for its time
+  // A frame that failed to decode, reported at its time when paced: a recording deleted mid-run
+  // then fails at the frame rate, not as fast as open() can fail.
+  bool pending_bad_ = false;
+  CameraStatus bad_status_;
   bool ended_reported_ = false;
 
   struct {
@@ -261,6 +265,7 @@ CameraStatus ReplayCamera::start() {
   loop_offset_ = 0;
   seq_ = 0;
   pending_slot_ = -1;
+  pending_bad_ = false;
   ended_reported_ = false;
   start_ns_ = monotonic_ns() + nominal_period_ns_;
   state_.store(LinkState::kStreaming, std::memory_order_release);
@@ -385,7 +390,7 @@ CameraStatus ReplayCamera::next_frame(Frame& frame, int timeout_ms) {
                                          nominal_period_ns_));
       next_index_ = 0;
     }
-    if (pending_slot_ < 0) {
+    if (pending_slot_ < 0 && !pending_bad_) {
       if (outstanding_ >= nbufs_) {
         const std::int64_t now = monotonic_ns();
         if (now >= deadline) {
@@ -402,12 +407,12 @@ CameraStatus ReplayCamera::next_frame(Frame& frame, int timeout_ms) {
       while (held_[static_cast<std::size_t>(slot)]) ++slot;
       // Decode ahead of the frame's time, on this (capture) thread.
       const CameraStatus st = decode(next_index_, slot);
-      if (!st.ok()) {
-        ++next_index_;
-        bump(n_.corrupt);
-        return st;
+      if (st.ok()) {
+        pending_slot_ = slot;
+      } else {
+        pending_bad_ = true;
+        bad_status_ = st;
       }
-      pending_slot_ = slot;
     }
     const std::int64_t stamp =
         rec::clamped_sum(rec::clamped_sum(start_ns_, loop_offset_),
@@ -423,6 +428,12 @@ CameraStatus ReplayCamera::next_frame(Frame& frame, int timeout_ms) {
         sleep_until_ns(std::min({stamp, deadline, now + kPollNs}));
         continue;
       }
+    }
+    if (pending_bad_) {
+      pending_bad_ = false;
+      ++next_index_;
+      bump(n_.corrupt);
+      return bad_status_;
     }
     const int slot = pending_slot_;
     pending_slot_ = -1;
