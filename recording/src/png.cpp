@@ -125,6 +125,10 @@ Status write_png(const std::filesystem::path& file, const ImageView& im, int lev
   spng_set_ihdr(ctx.get(), &ihdr);
   if (int e = spng_encode_image(ctx.get(), im.data, im.size(), SPNG_FMT_PNG, SPNG_ENCODE_FINALIZE);
       e != 0) {
+    // A write error (ENOSPC) surfaces as libspng's "stream error": name the cause instead.
+    const int write_errno = errno;
+    if (std::ferror(f.get()) != 0)
+      return Status::error(name(file) + ": write failed: " + std::strerror(write_errno));
     return Status::error(name(file) + ": PNG encoding failed: " + spng_strerror(e));
   }
   FILE* raw = f.release();

@@ -2,6 +2,8 @@
 // tacse3 recording: recording.json, frames.csv, truth.csv and sim_labels.csv reading and writing.
 #include "tacse3/recording/recording.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
@@ -486,7 +488,12 @@ Result<std::unique_ptr<RecordingWriter>> RecordingWriter::open(const fs::path& d
   w->frames_csv_ = std::fopen((dir / "frames.csv").c_str(), "wb");
   if (!w->frames_csv_)
     return err((dir / "frames.csv").string() + ": cannot create: " + std::strerror(errno));
-  std::fprintf(w->frames_csv_, "%s\n", kFramesHeader);
+  // Unbuffered: a recording cut short (disk full, power loss) lists every frame written so far.
+  std::setvbuf(w->frames_csv_, nullptr, _IONBF, 0);
+  const std::string header = std::string(kFramesHeader) + "\n";
+  if (std::fwrite(header.data(), 1, header.size(), w->frames_csv_) != header.size())
+    return err((dir / "frames.csv").string() + ": write failed: " + std::strerror(errno));
+  w->frames_csv_bytes_ = static_cast<long>(header.size());
   return w;
 }
 
@@ -531,9 +538,18 @@ Status RecordingWriter::append_frame_time(std::int64_t index, std::int64_t t_ns)
   }
   if (frames_ > 0 && t_ns <= last_t_ns_)
     return err("recording writer: t_ns must increase strictly");
-  if (std::fprintf(frames_csv_, "%" PRId64 ",%" PRId64 "\n", index, t_ns) < 0) {
-    return err((dir_ / "frames.csv").string() + ": write failed: " + std::strerror(errno));
+  char row[48];
+  const int n = std::snprintf(row, sizeof row, "%" PRId64 ",%" PRId64 "\n", index, t_ns);
+  if (std::fwrite(row, 1, static_cast<std::size_t>(n), frames_csv_) !=
+      static_cast<std::size_t>(n)) {
+    const int e = errno;
+    // A partial row would make the whole file unreadable: cut back to the last complete one.
+    std::clearerr(frames_csv_);
+    if (::ftruncate(::fileno(frames_csv_), frames_csv_bytes_) == 0)
+      std::fseek(frames_csv_, frames_csv_bytes_, SEEK_SET);
+    return err((dir_ / "frames.csv").string() + ": write failed: " + std::strerror(e));
   }
+  frames_csv_bytes_ += n;
   last_t_ns_ = t_ns;
   ++frames_;
   return {};
@@ -546,11 +562,28 @@ Status RecordingWriter::write_frame(std::int64_t t_ns, std::span<const ImageView
   }
   if (frames_ > 0 && t_ns <= last_t_ns_)
     return err("recording writer: t_ns must increase strictly");
+  // The PNGs first, the frames.csv row after them: frames.csv never lists a frame whose PNGs are
+  // incomplete, and the PNGs of a frame that failed are removed, so that a recording cut short
+  // (disk full) stays readable up to its last complete frame.
+  const std::int64_t i = frames_;
   for (std::size_t k = 0; k < images.size(); ++k) {
-    if (Status s = write_image(k, frames_, images[k]); !s) return s;
+    if (Status s = write_image(k, i, images[k]); !s) {
+      remove_pngs(i, k + 1);
+      return s;
+    }
   }
-  if (index) *index = frames_;
-  return append_frame_time(frames_, t_ns);
+  if (Status s = append_frame_time(i, t_ns); !s) {
+    remove_pngs(i, images.size());
+    return s;
+  }
+  if (index) *index = i;
+  return {};
+}
+
+void RecordingWriter::remove_pngs(std::int64_t index, std::size_t slots) {
+  std::error_code ec;
+  for (std::size_t k = 0; k < slots && k < info_.sensors.size(); ++k)
+    fs::remove(dir_ / frame_relative_path(info_.sensors[k], index), ec);
 }
 
 Status RecordingWriter::append_truth(const TruthSample& s) {

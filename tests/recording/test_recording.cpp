@@ -492,6 +492,34 @@ TEST(Recording, CrlfAndNoTrailingNewlineAreAccepted) {
   EXPECT_EQ(r.value().frame_count(), 3u);
 }
 
+// A write error part-way (here /dev/full in place of frame 2's right PNG: ENOSPC, as a full
+// disk): the message names the cause, frames.csv already lists the frames before it (written as
+// it goes, not at finish()), and the frame that failed leaves no PNG, so that the recording, never
+// finished, reads up to its last complete frame.
+TEST(Recording, AWriterCutShortLeavesAReadableRecording) {
+  TempDir tmp;
+  RecordingInfo info = small_info();
+  ASSERT_EQ(info.sensors.size(), 2u);
+  auto w = RecordingWriter::open(tmp.path(), info);
+  ASSERT_TRUE(w) << w.status().message();
+  std::vector<Image> ims;
+  for (unsigned s = 0; s < 2; ++s) ims.push_back(random_image(info.width, info.height, 3, s));
+  const std::vector<ImageView> views{view(ims[0]), view(ims[1])};
+  for (int i = 0; i < 2; ++i) ASSERT_TRUE(w.value()->write_frame(1000 + i * 1000, views));
+  fs::create_symlink("/dev/full", tmp.path() / "right/000002.png");
+  const Status st = w.value()->write_frame(3000, views);
+  ASSERT_FALSE(st);
+  EXPECT_NE(st.message().find("right/000002.png: write failed: No space left on device"),
+            std::string::npos)
+      << st.message();
+  EXPECT_FALSE(fs::exists(tmp.path() / "left/000002.png"));
+  EXPECT_FALSE(fs::is_symlink(tmp.path() / "right/000002.png"));
+  EXPECT_EQ(read_file(tmp.path() / "frames.csv"), "index,t_ns\n0,1000\n1,2000\n");
+  auto r = RecordingReader::open(tmp.path());
+  ASSERT_TRUE(r) << r.status().message();
+  EXPECT_EQ(r.value().frame_count(), 2u);
+}
+
 TEST(Recording, WriterRejectsInconsistentFrames) {
   TempDir tmp;
   auto w = RecordingWriter::open(tmp.path(), small_info());

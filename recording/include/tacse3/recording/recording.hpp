@@ -197,11 +197,13 @@ class RecordingWriter {
  private:
   RecordingWriter() = default;
   Status check_image(std::size_t slot, const ImageView& image) const;
+  void remove_pngs(std::int64_t index, std::size_t slots);
 
   std::filesystem::path dir_;
   RecordingInfo info_;
   WriterOptions options_;
-  std::FILE* frames_csv_ = nullptr;
+  std::FILE* frames_csv_ = nullptr;  // unbuffered: each row is on disk once appended
+  long frames_csv_bytes_ = 0;        // up to the last complete row
   std::FILE* truth_csv_ = nullptr;
   std::FILE* labels_csv_ = nullptr;
   std::int64_t frames_ = 0;
