@@ -451,7 +451,12 @@ Result<std::unique_ptr<RecordingWriter>> RecordingWriter::open(const fs::path& d
     if (!fs::is_directory(dir, ec)) return err(dir.string() + ": exists and is not a directory");
     const bool empty = fs::is_empty(dir, ec);
     if (!empty && !options.overwrite) {
-      return err(dir.string() + ": directory is not empty (use overwrite to replace a recording)");
+      const std::string or_option =
+          options.overwrite_option.empty()
+              ? std::string()
+              : " (or pass " + options.overwrite_option + " to replace the recording in it)";
+      return err(dir.string() + ": directory is not empty; give a new or empty directory" +
+                 or_option);
     }
     if (!empty) {
       // Remove only what a recording consists of; anything else in the directory stays.

@@ -220,6 +220,31 @@ check "replay with a 1e-9 mm finger separation exits 1" test $? -eq 1
 check "the separation and the range are named" \
   contains "$T/e19" "rig.finger_separation_mm 1e-09 is outside 1 .. 250 mm"
 
+# Values in messages are %g: 1e300 and 1e-300 read as such, not as 300 digits or 0.000000.
+for pitch in 1e300 1e-300; do
+  sed "s/\"pixel_pitch_mm\": [0-9.e+-]*/\"pixel_pitch_mm\": $pitch/" "$T/rec/recording.json" \
+    > "$T/recw/recording.json"
+  "$REPLAY" "$T/recw" --out "$T/x.csv" > /dev/null 2> "$T/e23"
+  check "replay with a $pitch mm pitch exits 1" test $? -eq 1
+  check "the $pitch mm pitch is written as %g" \
+    contains "$T/e23" "rig.pixel_pitch_mm $(printf '%g' "$pitch") is outside 0.001 .. 0.2 mm"
+done
+# A pitch twice the calibration's doubles c_velocity 80 to 160: the gain is blamed, not the pitch.
+sed 's/"pixel_pitch_mm": [0-9.e+-]*/"pixel_pitch_mm": 0.15/' "$T/rec/recording.json" \
+  > "$T/recw/recording.json"
+printf 'format = "tacse3-calibration"\nversion = 1\n[sensor]\nc_velocity = 80\n' > "$T/cv80.toml"
+"$REPLAY" "$T/recw" --calibration "$T/cv80.toml" --out "$T/x.csv" > /dev/null 2> "$T/e24"
+check "replay with c_velocity 80 at twice the pitch exits 1" test $? -eq 1
+check "the rescaled c_velocity is blamed" contains "$T/e24" "rescales its c_velocity 80 to 160"
+check "the pitch itself is not called out of range" lacks "$T/e24" "is outside 0.001"
+if [ -n "$TACSE3D" ]; then
+  bounded "$TACSE3D" --board sim --seconds 1 --can-log /dev/null --record "$T/rec" \
+    > /dev/null 2> "$T/e25"
+  check "tacse3d --record into a recording exits 1" test $? -eq 1
+  check "tacse3d --record asks for a new directory" contains "$T/e25" "give a new or empty directory"
+  check "tacse3d --record offers no overwrite option" lacks "$T/e25" "overwrite"
+fi
+
 rm "$T/rec/truth.csv"
 "$CAL" "$T/rec" --out "$T/cal.toml" > /dev/null 2> "$T/e4"
 check "calibrate without truth exits 1" test $? -eq 1

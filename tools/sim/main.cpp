@@ -142,6 +142,7 @@ int run(int argc, char** argv) {
   rec::WriterOptions wopt;
   wopt.png_compression = o.png_level;
   wopt.overwrite = o.overwrite;
+  wopt.overwrite_option = "--overwrite";
   auto opened = rec::RecordingWriter::open(o.out, info, wopt);
   if (!opened) return fail(opened.status().message());
   const std::unique_ptr<rec::RecordingWriter> writer_ptr = std::move(opened).value();

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "tacse3/config/board_file.hpp"
+#include "tacse3/dsp/calibration_fields.hpp"
 #include "tacse3/tools/can_log.hpp"
 #include "tacse3/tools/field_dump.hpp"
 #include "tacse3/tools/progress.hpp"
@@ -117,6 +118,38 @@ std::string check_separation(const SourceInfo& info) {
   return info.name + buf;
 }
 
+// Why the calibration rescaled to the rig's pitch is invalid, blaming what is out of range: the
+// pitch itself, or a proxy gain that the pitch ratio pushed over its bound. %g keeps 1e300 and
+// 1e-300 readable.
+std::string rescale_error(const SourceInfo& info, const char* side, const dsp::Calibration& given,
+                          const dsp::Calibration& rescaled) {
+  char buf[384];
+  const dsp::CalibrationField* pitch = dsp::find_calibration_field("pixel_pitch_m");
+  if (!dsp::field_valid(*pitch, rescaled)) {
+    std::snprintf(buf, sizeof buf,
+                  "/recording.json: rig.pixel_pitch_mm %g is outside %g .. %g mm; correct the rig "
+                  "block",
+                  info.pixel_pitch_mm, pitch->lo * 1e3, pitch->hi * 1e3);
+    return info.name + buf;
+  }
+  for (const char* key : {"c_velocity", "c_displacement"}) {
+    const dsp::CalibrationField* f = dsp::find_calibration_field(key);
+    if (dsp::field_valid(*f, rescaled)) continue;
+    std::snprintf(buf, sizeof buf,
+                  "/recording.json: rig.pixel_pitch_mm %g is %g times the %s calibration's pitch, "
+                  "which rescales its %s %g to %g, outside %g .. %g %s; lower %s in the "
+                  "calibration or check the pitch",
+                  info.pixel_pitch_mm, rescaled.pixel_pitch_m / given.pixel_pitch_m, side, key,
+                  given.*(f->real), rescaled.*(f->real), f->lo, f->hi, f->unit, key);
+    return info.name + buf;
+  }
+  std::snprintf(buf, sizeof buf,
+                "/recording.json: rig.pixel_pitch_mm %g makes the %s calibration invalid; check "
+                "the calibration",
+                info.pixel_pitch_mm, side);
+  return info.name + buf;
+}
+
 }  // namespace
 
 std::optional<bool> detected_slip(const dsp::SensorResult& r) noexcept {
@@ -153,17 +186,13 @@ std::string make_setup(const SourceInfo& info, const ReplayOptions& options, Eng
     // per pixel of shear, so they scale with the pitch. That keeps the units; the grid and the
     // smoothing are in pixels, so a slide still reads a few per cent differently at another
     // pitch (docs/replay.md).
+    const dsp::Calibration given = c;
     const double ratio = pitch_m / c.pixel_pitch_m;
     c.pixel_pitch_m = pitch_m;
     c.c_velocity *= ratio;
     c.c_displacement *= ratio;
     c.velocity_proxy = pipeline_proxy(options.mode);
-    if (dsp::validate(c) != dsp::Status::kOk) {
-      return info.name + "/recording.json: rig.pixel_pitch_mm " +
-             std::to_string(info.pixel_pitch_mm) + " makes the " + names[k] +
-             " calibration invalid (pixel pitch must be 0.001 .. 0.2 mm and the rescaled proxy "
-             "gains within their ranges)";
-    }
+    if (dsp::validate(c) != dsp::Status::kOk) return rescale_error(info, names[k], given, c);
   }
   s.dual.fusion.method = options.method;
   s.dual.finger_separation_m = info.finger_separation_mm * 1e-3;

@@ -164,6 +164,9 @@ std::filesystem::path frame_relative_path(SensorId sensor, std::int64_t index);
 struct WriterOptions {
   int png_compression = 1;  // zlib level 0..9 (1: fast; frames are noisy and barely compress)
   bool overwrite = false;   // replace the recording files in an existing directory
+  // The caller's option that sets overwrite ("--overwrite"), named when a directory is refused;
+  // empty: the caller has none, and the message asks for another directory only.
+  std::string overwrite_option;
 };
 
 // Writes a recording directory. recording.json is written by open(); frames.csv, truth.csv and
