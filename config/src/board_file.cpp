@@ -233,6 +233,18 @@ class Reader {
   std::string error_;
 };
 
+// [sim] object must be one of the simulator's presets: --check then refuses what the run would.
+void check_sim_object(Reader& rd, const toml::table& t, const std::string& object) {
+  if (!rd.ok() || t.get("object") == nullptr) return;
+  std::string list;
+  for (const char* name : kSimObjectNames) {
+    if (object == name) return;
+    list += std::string(list.empty() ? "" : " | ") + name;
+  }
+  rd.fail(t.get("object"),
+          "key \"sim.object\" must be one of " + list + ", got \"" + object + "\"");
+}
+
 void read_sensor(Reader& rd, const toml::table& t, const std::string& path, SensorBoardConfig* s) {
   s->enabled = true;
   if (!rd.only_keys(t, path,
@@ -356,6 +368,7 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
     rd.only_keys(*t, "sim",
                  {"object", "motion", "magnitude", "regime", "seed", "repeat", "realtime"});
     rd.string(*t, "object", "sim", &b.sim.object);
+    check_sim_object(rd, *t, b.sim.object);
     rd.choice<std::string>(*t, "motion", "sim",
                            {{"rx", "rx"}, {"ry", "ry"}, {"rz", "rz"}, {"tx", "tx"}, {"ty", "ty"}},
                            &b.sim.motion);

@@ -166,6 +166,22 @@ TEST(Board, OutOfRangeValuesAreNamed) {
   EXPECT_NE(syn.find("TOML syntax error"), std::string::npos) << syn;
 }
 
+// A [sim] object the simulator has no preset for is refused by the parse (and so by --check),
+// not later by the run.
+TEST(Board, SimObjectMustBeASimulatorPreset) {
+  const std::string e = error_of(std::string(kMinimal) + "[sim]\nobject = \"banana\"\n");
+  EXPECT_NE(e.find("test.toml:5"), std::string::npos) << e;
+  EXPECT_NE(e.find("key \"sim.object\" must be one of sphere | large-sphere"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("got \"banana\""), std::string::npos) << e;
+  BoardConfig b;
+  std::string err;
+  ASSERT_TRUE(
+      parse_board(std::string(kMinimal) + "[sim]\nobject = \"screwdriver\"\n", "t.toml", &b, &err))
+      << err;
+  EXPECT_EQ(b.sim.object, "screwdriver");
+}
+
 TEST(Board, ResolvesNamesInTheDocumentedOrder) {
   const fs::path dir = scratch_dir();
   fs::create_directories(dir / "env/mine");

@@ -180,6 +180,15 @@ if [ -n "$TACSE3D" ]; then
   check "the CAN log error is said once" test "$(grep -c 'write failed' "$T/e22")" -eq 1
 fi
 
+# --check refuses a [sim] object the simulator has no preset for, as the run would.
+if [ -n "$TACSE3D" ]; then
+  sed 's/^object = .*/object = "banana"/' "$(dirname "$0")/../../boards/sim/board.toml" \
+    > "$T/banana.toml"
+  "$TACSE3D" --board "$T/banana.toml" --check > /dev/null 2> "$T/e26"
+  check "tacse3d --check with object banana exits 1" test $? -eq 1
+  check "tacse3d names sim.object and banana" contains "$T/e26" 'key "sim.object" must be one of'
+fi
+
 # Results on a full standard output are an error, not exit 0.
 "$REPLAY" "$T/rec" --out - > /dev/full 2> "$T/e14"
 check "replay --out - > /dev/full exits 1" test $? -eq 1

@@ -34,6 +34,13 @@ struct SensorBoardConfig {
   std::array<std::array<double, 3>, 3> rotation{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
 };
 
+// The [sim] object names: the simulator's presets (sim::object_preset_names(), in its order).
+// config may not include sim, so the list is kept here and tests/config checks the two agree;
+// --check can then refuse a name the run would fail on.
+inline constexpr std::array<const char*, 11> kSimObjectNames{
+    "sphere", "large-sphere", "ellipsoid",   "bumpy",         "irregular",  "cylinder",
+    "cube",   "plastic-cube", "wooden-cube", "textured-cube", "screwdriver"};
+
 // [sim]: the live simulator's scenario (only read when a sensor uses backend "sim").
 struct SimBoardConfig {
   std::string object = "sphere";
