@@ -34,6 +34,16 @@ check "replay CSV header" test "$(head -1 "$T/out.csv")" = \
 check "replay CSV rows = frames" test "$(($(wc -l < "$T/out.csv") - 1))" -eq "$frames"
 check "replay summary has the rotation" contains "$T/stdout" "rotation: *estimated"
 check "replay summary has the truth" contains "$T/stdout" "truth *2.00 deg"
+check "a full truth gives no truth warning" lacks "$T/stdout" "truth.csv ends at"
+
+# A truth.csv that ends before the last frame: the summary warns, naming the file and its end.
+cp -r "$T/rec" "$T/rect"
+head -3 "$T/rec/truth.csv" > "$T/rect/truth.csv"
+truth_end=$(tail -1 "$T/rect/truth.csv" | cut -d, -f1)
+"$REPLAY" "$T/rect" --out "$T/x.csv" > "$T/stdout_t" 2> /dev/null
+check "replay with a short truth exits 0" test $? -eq 0
+check "the short truth is warned about" contains "$T/stdout_t" \
+  "warning: $T/rect/truth.csv ends at t = $(awk -v t="$truth_end" 'BEGIN { printf "%.3f", t * 1e-9 }') s"
 
 "$REPLAY" "$T/rec" --out - --method paper --mode displacement --sensors left -q > "$T/o2" 2>&1
 check "replay to stdout" test "$(($(wc -l < "$T/o2") - 1))" -eq "$frames"

@@ -176,6 +176,13 @@ int run(int argc, char** argv) {
     std::fprintf(report, "  translation: estimated %7.2f mm, truth %7.2f mm -> error %.2f mm\n",
                  e.estimated_translation_mm, e.true_translation_mm, e.final_translation_error_mm);
     print_tracking(report, sum.tracking);
+    if (sum.truth_ends_early) {
+      std::fprintf(report,
+                   "  warning: %s/truth.csv ends at t = %.3f s, before the last frame (%.3f s): "
+                   "the frames after it are compared with its last pose\n",
+                   rec_dir.c_str(), static_cast<double>(sum.truth_end_ns) * 1e-9,
+                   static_cast<double>(sum.last_frame_ns) * 1e-9);
+    }
   }
   if (sum.has_slip_score) {
     const auto& s = sum.slip;

@@ -338,6 +338,9 @@ RunSummary summarize(const SourceInfo& info, const std::vector<FrameResult>& fra
     }
     s.errors = pose_errors(poses, info.truth, t);
     s.tracking = tracking_error(poses, info.truth, t);
+    s.truth_end_ns = info.truth.back().t_ns;
+    s.last_frame_ns = frames.back().t_ns;
+    s.truth_ends_early = s.truth_end_ns < s.last_frame_ns;
   }
   if (!info.labels.empty()) {
     for (const auto& l : info.labels) {

@@ -119,6 +119,11 @@ struct RunSummary {
   bool has_truth = false;
   PoseErrors errors{};
   TrackingError tracking{};  // per frame from the motion's start (with truth)
+  // The truth ends before the last frame: later frames are compared with its last pose, so the
+  // final errors say little (the summary warns).
+  bool truth_ends_early = false;
+  std::int64_t truth_end_ns = 0;
+  std::int64_t last_frame_ns = 0;
   bool has_slip_score = false;
   SlipScore slip{};
   double valid_fraction = 0.0;  // frames with a valid estimate
