@@ -76,8 +76,10 @@ bool create_temporary(const fs::path& file, OwnedFile* tmp, std::string* error) 
   static std::atomic<unsigned> counter{0};
   const fs::path dir = directory_of(file);
   for (int attempt = 0; attempt < 100; ++attempt) {
-    const std::string name = "." + file.filename().string() + ".tmp-" + std::to_string(::getpid()) +
-                             "-" + std::to_string(counter++);
+    // Appended piece by piece: GCC 12 at -O3 reports a false -Wrestrict for "." + std::string.
+    std::string name(1, '.');
+    name += file.filename().string();
+    name += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
     const std::string path = (dir / name).string();
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0666);
     if (fd >= 0) {
