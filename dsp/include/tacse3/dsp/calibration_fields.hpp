@@ -158,11 +158,14 @@ constexpr bool field_in_range(const CalibrationField& f, double v) noexcept {
 // Whether the field's value in c is valid (each element for kVec3; a named mode for kProxy).
 constexpr bool field_valid(const CalibrationField& f, const Calibration& c) noexcept {
   switch (f.kind) {
+    // The member checks cost nothing and keep a malformed entry (a kind without its member) from
+    // dereferencing null; tests/dsp/test_calibration_fields.cpp checks every entry has its member.
     case CalibrationField::Kind::kReal:
-      return field_in_range(f, c.*(f.real));
+      return f.real != nullptr && field_in_range(f, c.*(f.real));
     case CalibrationField::Kind::kInt:
-      return field_in_range(f, static_cast<double>(c.*(f.integer)));
+      return f.integer != nullptr && field_in_range(f, static_cast<double>(c.*(f.integer)));
     case CalibrationField::Kind::kVec3:
+      if (f.vec == nullptr) return false;
       for (const double v : c.*(f.vec)) {
         if (!field_in_range(f, v)) return false;
       }
