@@ -125,7 +125,7 @@ std::string rescale_error(const SourceInfo& info, const char* side, const dsp::C
                           const dsp::Calibration& rescaled) {
   char buf[384];
   const dsp::CalibrationField* pitch = dsp::find_calibration_field("pixel_pitch_m");
-  if (!dsp::field_valid(*pitch, rescaled)) {
+  if (pitch != nullptr && !dsp::field_valid(*pitch, rescaled)) {
     std::snprintf(buf, sizeof buf,
                   "/recording.json: rig.pixel_pitch_mm %g is outside %g .. %g mm; correct the rig "
                   "block",
@@ -134,7 +134,7 @@ std::string rescale_error(const SourceInfo& info, const char* side, const dsp::C
   }
   for (const char* key : {"c_velocity", "c_displacement"}) {
     const dsp::CalibrationField* f = dsp::find_calibration_field(key);
-    if (dsp::field_valid(*f, rescaled)) continue;
+    if (f == nullptr || f->real == nullptr || dsp::field_valid(*f, rescaled)) continue;
     std::snprintf(buf, sizeof buf,
                   "/recording.json: rig.pixel_pitch_mm %g is %g times the %s calibration's pitch, "
                   "which rescales its %s %g to %g, outside %g .. %g %s; lower %s in the "
