@@ -3,10 +3,8 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <cerrno>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -15,6 +13,7 @@
 #include "output.hpp"
 #include "tacse3/hal/can/log_channel.hpp"
 #include "tacse3/hal/can/socketcan.hpp"
+#include "tacse3/tools/cli.hpp"
 
 namespace {
 
@@ -138,15 +137,7 @@ int main(int argc, char** argv) {
   if (tty != nullptr) tty->draw();
   if (json != nullptr) json->stats("summary");
   // The decoded frames are the result: a write error on stdout (a full disk) must not exit 0.
-  errno = 0;
-  const bool out_ok = std::fflush(stdout) == 0 && std::ferror(stdout) == 0;
-  const int out_errno = errno;
-  if (!out_ok) {
-    std::cerr << "tacse3-canmon: error: standard output: write error"
-              << (out_errno != 0 ? std::string(" (") + std::strerror(out_errno) + ")" : "")
-              << "; the output is incomplete\n";
-    rc = 1;
-  }
+  rc = tacse3::tools::finish_stdout("tacse3-canmon", rc);
   if (auto* log = dynamic_cast<can::LogChannel*>(channel.get());
       log != nullptr && log->bad_lines() > 0) {
     std::cerr << "tacse3-canmon: skipped " << log->bad_lines()

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 tools: command-line rules shared by the CLI11 tools (header-only: included only by tools
-// that link CLI11; tacse3_tools_common itself does not use it).
+// tacse3 tools: command-line rules shared by the CLI11 tools (header-only, target
+// tacse3_tools_cli).
 #pragma once
 
 #include <CLI/CLI.hpp>
