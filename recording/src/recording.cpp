@@ -221,10 +221,10 @@ bool parse_bool01(std::string_view s, bool* out) {
   return false;
 }
 
-// Reads a regular file of at most max_bytes; a FIFO or a device is an error at once.
-Status read_text(const fs::path& file, const std::string& label, std::size_t max_bytes,
-                 std::string* out) {
-  const fileio::ReadResult r = fileio::read_regular_file(file, max_bytes, out);
+// Reads <dir>/<name>, a regular file of at most max_bytes; a FIFO or a device is an error at once.
+Status read_text(const fs::path& dir, const char* name, std::size_t max_bytes, std::string* out) {
+  const std::string label = dir.string() + "/" + name;
+  const fileio::ReadResult r = fileio::read_regular_file(dir / name, max_bytes, out);
   switch (r.error) {
     case fileio::ReadError::kNone:
       return {};
@@ -684,14 +684,11 @@ Result<RecordingReader> RecordingReader::open_impl(const fs::path& dir,
   const std::string where = dir.string() + "/";
   std::string text;
   if (!fs::exists(dir / "recording.json", ec)) return err(where + "recording.json: missing");
-  if (Status s = read_text(dir / "recording.json", where + "recording.json", kMaxJsonBytes, &text);
-      !s)
-    return s;
+  if (Status s = read_text(dir, "recording.json", kMaxJsonBytes, &text); !s) return s;
   if (Status s = parse_info(text, &r.info_); !s) return err(where + s.message());
 
   if (!fs::exists(dir / "frames.csv", ec)) return err(where + "frames.csv: missing");
-  if (Status s = read_text(dir / "frames.csv", where + "frames.csv", kMaxCsvBytes, &text); !s)
-    return s;
+  if (Status s = read_text(dir, "frames.csv", kMaxCsvBytes, &text); !s) return s;
   if (Status s = parse_frames(text, &r.t_ns_); !s) return err(where + s.message());
   if (r.t_ns_.empty()) return err(where + "frames.csv: no frames");
 
@@ -737,15 +734,12 @@ Result<RecordingReader> RecordingReader::open_impl(const fs::path& dir,
   }
 
   if (fs::exists(dir / "truth.csv", ec)) {
-    if (Status s = read_text(dir / "truth.csv", where + "truth.csv", kMaxCsvBytes, &text); !s)
-      return s;
+    if (Status s = read_text(dir, "truth.csv", kMaxCsvBytes, &text); !s) return s;
     if (Status s = parse_truth(text, &r.truth_); !s) return err(where + s.message());
     r.has_truth_ = true;
   }
   if (fs::exists(dir / "sim_labels.csv", ec)) {
-    if (Status s = read_text(dir / "sim_labels.csv", where + "sim_labels.csv", kMaxCsvBytes, &text);
-        !s)
-      return s;
+    if (Status s = read_text(dir, "sim_labels.csv", kMaxCsvBytes, &text); !s) return s;
     if (Status s = parse_labels(text, &r.labels_); !s) return err(where + s.message());
     r.has_labels_ = true;
   }

@@ -148,7 +148,6 @@ TrackingError tracking_error(const std::vector<dsp::Pose>& estimate,
   e.frames = n - first;
   const std::int64_t period = median_period_ns(t_ns);
   const int lags = period > 0 ? static_cast<int>(std::floor(max_lag_s * 1e9 / period + 1e-9)) : 0;
-  bool have_rot = false, have_trans = false;
   for (int k = 0; k <= lags; ++k) {
     LagScore rot, trans;
     for (std::size_t i = first; i < n; ++i) {
@@ -163,14 +162,12 @@ TrackingError tracking_error(const std::vector<dsp::Pose>& estimate,
     rot.rms = std::sqrt(rot.rms / static_cast<double>(e.frames));
     trans.rms = std::sqrt(trans.rms / static_cast<double>(e.frames));
     const double lag_s = static_cast<double>(k * period) * 1e-9;
-    if (!have_rot || rot.rms < e.rotation_rms_deg) {
-      have_rot = true;
+    if (k == 0 || rot.rms < e.rotation_rms_deg) {
       e.rotation_rms_deg = rot.rms;
       e.rotation_max_deg = rot.max;
       e.rotation_lag_s = lag_s;
     }
-    if (!have_trans || trans.rms < e.translation_rms_mm) {
-      have_trans = true;
+    if (k == 0 || trans.rms < e.translation_rms_mm) {
       e.translation_rms_mm = trans.rms;
       e.translation_max_mm = trans.max;
       e.translation_lag_s = lag_s;
