@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 protocol: tacse3-dbcgen, writes the DBC of one node from the message table.
+// tacse3 protocol: tacse3-dbcgen, writes the DBC of one node (or the whole table as JSON for the
+// Python package) from the message table.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
@@ -7,6 +8,7 @@
 #include <string>
 
 #include "tacse3/protocol_dbc/dbc_writer.hpp"
+#include "tacse3/protocol_dbc/table_json.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Write the tacse3 CAN DBC (generated from the protocol message table)",
@@ -16,6 +18,7 @@ int main(int argc, char** argv) {
   std::string base = "0x1ACE0000";
   std::string prefix;
   std::string output = "-";
+  std::string format = "dbc";
   app.add_option("--node", node, "Node id of the gripper (1..63)")
       ->check(CLI::Range(1u, 63u))
       ->capture_default_str();
@@ -23,6 +26,10 @@ int main(int argc, char** argv) {
   app.add_option("--extended-base", base, "Base of the 29-bit identifiers (bits 11..28)")
       ->capture_default_str();
   app.add_option("--prefix", prefix, "Prefix for every message name (merging several nodes)");
+  app.add_option("--format", format,
+                 "dbc, or json: the node-independent message table (python/src/tacse3)")
+      ->check(CLI::IsMember({"dbc", "json"}))
+      ->capture_default_str();
   app.add_option("-o,--output", output, "Output file, - for stdout")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
@@ -45,7 +52,8 @@ int main(int argc, char** argv) {
     }
     opt.endpoint.layout.extended_base = static_cast<std::uint32_t>(b);
   }
-  const std::string dbc = tacse3::protocol::dbc::generate_dbc(opt);
+  const std::string dbc = format == "json" ? tacse3::protocol::dbc::generate_table_json()
+                                           : tacse3::protocol::dbc::generate_dbc(opt);
   if (output == "-") {
     std::cout << dbc;
     return std::cout.good() ? 0 : 1;
