@@ -26,8 +26,9 @@ PACKAGES=(
   systemd
   # fuzzing (libFuzzer and sanitizer runtimes for clang)
   libclang-rt-14-dev
-  # protocol cross-checks: python-can example and the independent DBC decoder (npm)
-  python3 python3-can
+  # the Python package (python/): python-can; its wheel is built offline with Debian's pip,
+  # setuptools and wheel. Also the protocol cross-check with the independent DBC decoder (npm).
+  python3 python3-can python3-pip python3-setuptools python3-wheel
 )
 # The real-driver VM suite (tests/vm): qemu-system, kmod, the module build tools. Its guest kernels
 # and userland are fetched at test time with apt-get download into build/vm/.

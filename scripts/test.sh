@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # tacse3: the test command. Builds and runs the host tests, the ASan+UBSan build and the aarch64
-# build under qemu-user, then builds and checks the arm64/armhf .deb packages, runs the bounded
+# build under qemu-user (the host presets include the Python package's tests), then builds and
+# checks the arm64/armhf .deb packages and the Python wheel and .deb, runs the bounded
 # protocol fuzzers and the real-driver VM suite (tests/vm: SocketCAN, V4L2, libcamera, GPIO in
 # qemu-system guests). Exits non-zero on any failure.
 # Skips: TACSE3_SKIP_PACKAGE=1, TACSE3_SKIP_FUZZ=1, TACSE3_SKIP_VM=1.
@@ -23,10 +24,13 @@ for preset in "${presets[@]}"; do
   summary+=("$preset: ok")
 done
 
-# The arm64 and armhf .deb packages, built and checked against tests/packaging/contents.txt.
+# The arm64 and armhf .deb packages, built and checked against tests/packaging/contents.txt, and
+# the Python package's wheel and python3-tacse3 .deb (build/python-package).
 if [ "${TACSE3_SKIP_PACKAGE:-0}" != "1" ]; then
   echo "=== .deb packages (arm64, armhf) ==="
   scripts/package.sh
+  echo "=== Python package (wheel, python3-tacse3 .deb) ==="
+  scripts/package-python.sh
   summary+=("package: ok")
 fi
 
