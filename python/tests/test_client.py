@@ -56,14 +56,16 @@ class FakeGripper(threading.Thread):
 
 
 class ClientTest(unittest.TestCase):
-    def start(self, **kw):
+    def start(self, timeout=2.0, **kw):
+        """A client (timeout generous enough for a loaded machine; answers end the wait) and a
+        gripper on a fresh virtual bus."""
         channel = f"tacse3-test-{next(_channels)}"
         bus = can.Bus(interface="virtual", channel=channel)
         gripper = FakeGripper(channel, **kw)
         gripper.start()
         self.addCleanup(bus.shutdown)
         self.addCleanup(gripper.close)
-        return tacse3.Client(bus, node=1, timeout=0.3), gripper
+        return tacse3.Client(bus, node=1, timeout=timeout), gripper
 
     def test_ack_with_incrementing_sequence(self):
         client, gripper = self.start()
@@ -107,7 +109,7 @@ class ClientTest(unittest.TestCase):
         self.assertEqual(gripper.commands[0].arguments, {"QueryItem": "STREAM"})
 
     def test_timeout_on_a_silent_bus(self):
-        client, _ = self.start(answer=lambda c: None)
+        client, _ = self.start(0.3, answer=lambda c: None)
         t0 = time.monotonic()
         with self.assertRaisesRegex(tacse3.AckTimeout,
                                     r"no ACK from node 1 for TARE \(seq 0\) within 0.3 s: the bus "
@@ -117,14 +119,14 @@ class ClientTest(unittest.TestCase):
 
     def test_timeout_when_the_node_talks_but_does_not_answer(self):
         status = tacse3.Status(node=1, state="TRACKING").encode()
-        client, _ = self.start(answer=lambda c: None, chatter=status)
+        client, _ = self.start(0.3, answer=lambda c: None, chatter=status)
         with self.assertRaisesRegex(tacse3.AckTimeout, r"node 1 is sending \(\d+ frames\) but "
                                                        "did not answer"):
             client.tare()
 
     def test_timeout_when_only_other_nodes_talk(self):
         status = tacse3.Status(node=2, state="TRACKING").encode()
-        client, _ = self.start(answer=lambda c: None, chatter=status)
+        client, _ = self.start(0.3, answer=lambda c: None, chatter=status)
         with self.assertRaisesRegex(tacse3.AckTimeout, r"\d+ frames arrived, none from node 1 "
                                                        r"\(check the node id"):
             client.tare()
