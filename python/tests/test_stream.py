@@ -1,7 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 """candump -L reading/writing and the BusDecoder's cycle reassembly and fault counting."""
 
-import io
 import os
 import unittest
 

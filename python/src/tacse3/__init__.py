@@ -28,4 +28,5 @@ __all__ = [
     "Cycle", "CycleReassembler", "FrameError", "IdLayout", "LogReader", "NackError",
     "PROTOCOL_VERSION", "Status", "StatusContact", "StatusCounters", "StatusTiming", "crc8",
     "decode", "encode_ack", "encode_command", "encode_cycle", "format_line", "parse_line",
+    "table",
 ]

@@ -11,7 +11,8 @@ import can
 
 _CAN_ERR_FLAG = 0x20000000
 _FD_LENGTHS = (0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64)
-_LINE = re.compile(r"\s*\((\d+)\.(\d{1,9})\)\s+([!-~]{1,16})\s+([0-9A-Fa-f]+)#(.*?)(?:\s+[RT])?\s*$")
+_LINE = re.compile(
+    r"\s*\((\d+)\.(\d{1,9})\)\s+([!-~]{1,16})\s+([0-9A-Fa-f]+)#(.*?)(?:\s+[RT])?\s*$")
 _DATA = re.compile(r"(?:#([0-9A-Fa-f]))?([0-9A-Fa-f]*)(?:_([0-9A-Fa-f]))?")
 
 
@@ -68,7 +69,8 @@ def format_line(msg, iface=None):
     if msg.is_remote_frame and not msg.is_fd:
         body = "R" + (f"{msg.dlc:X}" if msg.dlc else "")
     else:
-        body = (f"#{1 if msg.bitrate_switch else 0}" if msg.is_fd else "") + bytes(msg.data).hex().upper()
+        flags = f"#{1 if msg.bitrate_switch else 0}" if msg.is_fd else ""
+        body = flags + bytes(msg.data).hex().upper()
     return f"({us // 1000000:010d}.{us % 1000000:06d}) {chan} {ident}#{body}"
 
 

@@ -83,7 +83,8 @@ def split_id(layout, can_id, extended):
     if not layout.extended:
         if extended or can_id > _STANDARD_MASK:
             return None
-    elif not extended or can_id > _EXTENDED_MASK or can_id & ~_STANDARD_MASK != layout.extended_base:
+    elif (not extended or can_id > _EXTENDED_MASK
+          or can_id & ~_STANDARD_MASK != layout.extended_base):
         return None
     node = (can_id >> table.MESSAGE_ID_BITS) & _NODE_MASK
     if node == 0:
