@@ -70,6 +70,12 @@ std::string validate(const CameraSpec& c) {
   if (!finite_in(c.noise, 0.0, 100.0)) return "camera noise must be in [0, 100]";
   if (!finite_in(c.electrons_per_dn, 0.01, 1e6)) return "camera electrons_per_dn must be > 0";
   if (!finite_in(c.read_noise_dn, 0.0, 100.0)) return "camera read_noise_dn must be in [0, 100]";
+  if (c.mjpeg_quality < 0 || c.mjpeg_quality > 100)
+    return "camera mjpeg_quality must be in [0, 100]";
+  if (c.mjpeg_quality > 0 && !mjpeg_available()) {
+    return "camera mjpeg_quality needs libturbojpeg, which this build lacks "
+           "(apt-get install libturbojpeg0-dev)";
+  }
   return validate(c.shading);
 }
 
@@ -128,6 +134,7 @@ void Camera::build(const RigSpec& rig, const CameraSpec& spec, std::uint64_t see
     normal_[static_cast<std::size_t>(k)] =
         static_cast<float>(normal_quantile((k + 0.5) / kNormalTableSize));
   }
+  if (spec.mjpeg_quality > 0) (void)mjpeg_.build(w, h, spec.mjpeg_quality);
 }
 
 double Camera::flicker_gain(std::int64_t t_ns) const noexcept {
@@ -142,7 +149,7 @@ double Camera::flicker_gain(std::int64_t t_ns) const noexcept {
   return 1.0 + spec_.flicker * (0.6 * slow + 0.4 * fast);
 }
 
-void Camera::render(const Pattern& pattern, const PadFields& f, std::int64_t t_ns,
+bool Camera::render(const Pattern& pattern, const PadFields& f, std::int64_t t_ns,
                     std::uint8_t* out, int channels) noexcept {
   const int w = rig_.width, h = rig_.height, gw = f.gw, gh = f.gh;
   const auto uw = static_cast<std::size_t>(w);
@@ -208,6 +215,7 @@ void Camera::render(const Pattern& pattern, const PadFields& f, std::int64_t t_n
       o[k] = quantise(v + sigma[lvl] * zline[k]);
     }
   }
+  return spec_.mjpeg_quality <= 0 || mjpeg_.roundtrip(out, channels);
 }
 
 }  // namespace tacse3::sim

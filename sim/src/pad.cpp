@@ -6,6 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
+
+#include "tacse3/sim/rng.hpp"
 
 namespace tacse3::sim {
 namespace {
@@ -22,7 +25,33 @@ bool finite_in(double v, double lo, double hi) {
 
 }  // namespace
 
+const char* to_string(BulgeModel m) noexcept {
+  return m == BulgeModel::kRadialVolume ? "radial-volume" : "smoothed-gradient";
+}
+const char* to_string(SlideLaw m) noexcept {
+  switch (m) {
+    case SlideLaw::kTanh:
+      return "tanh";
+    case SlideLaw::kCoulombRim:
+      return "coulomb-rim";
+    case SlideLaw::kViscousCapped:
+      break;
+  }
+  return "viscous-capped";
+}
+const char* to_string(SpreadKernel m) noexcept {
+  return m == SpreadKernel::kHalfSpace ? "half-space" : "thin-layer";
+}
+
 std::string validate(const GelSpec& g) {
+  if (g.bulge_model > BulgeModel::kRadialVolume) return "gel bulge_model is not a known model";
+  if (g.slide_law > SlideLaw::kCoulombRim) return "gel slide_law is not a known law";
+  if (g.spread_kernel > SpreadKernel::kHalfSpace) return "gel spread_kernel is not a known kernel";
+  if (!finite_in(g.bulge_surface_factor, 0.0, 10.0))
+    return "gel bulge_surface_factor must be in [0, 10]";
+  if (!finite_in(g.gel_thickness_mm, 0.1, 50.0)) return "gel gel_thickness_mm must be in [0.1, 50]";
+  if (!finite_in(g.friction_variation, 0.0, 0.9))
+    return "gel friction_variation must be in [0, 0.9]";
   if (!finite_in(g.spread_length_mm, 0.1, 50.0)) return "gel spread_length_mm must be in [0.1, 50]";
   if (!finite_in(g.bulge_gain_mm, 0.0, 20.0)) return "gel bulge_gain_mm must be in [0, 20]";
   if (!finite_in(g.bulge_sigma_mm, 0.1, 20.0)) return "gel bulge_sigma_mm must be in [0.1, 20]";
@@ -80,7 +109,7 @@ void PadFields::allocate(const RigSpec& rig) {
 }
 
 void PadPhysics::build(Sensor sensor, const RigSpec& rig, const GelSpec& gel,
-                       const ShadingSpec& shading) {
+                       const ShadingSpec& shading, std::uint64_t seed) {
   sensor_ = sensor;
   rig_ = rig;
   gel_ = gel;
@@ -99,7 +128,43 @@ void PadPhysics::build(Sensor sensor, const RigSpec& rig, const GelSpec& gel,
         static_cast<double>(std::exp(-0.5 * k * k / (sigma_cells * sigma_cells)) / sum);
   }
   scratch_.assign(f_.depth_mm.size(), 0.0);
+  build_friction_map(seed);
+  capped_.assign(f_.depth_mm.size(), 0);
+  radial_mass_.clear();
+  if (gel.bulge_model == BulgeModel::kRadialVolume) {
+    const double diag =
+        std::hypot(f_.u_mm.back() - f_.u_mm.front(), f_.v_mm.back() - f_.v_mm.front());
+    radial_mass_.assign(static_cast<std::size_t>(std::ceil(diag / (0.5 * f_.cell_mm))) + 2, 0.0);
+  }
+  if (gel.spread_kernel == SpreadKernel::kHalfSpace) {
+    halfspace_.build(f_.gw, f_.gh, f_.cell_mm, gel.spread_length_mm);
+  }
   reset();
+}
+
+// mu(x) = mu (1 + a m(x)): m is the mean of three plane waves of 4-12 mm wavelength (a gel's
+// coating and the object's surface vary on the scale of millimetres), so |m| <= 1.
+void PadPhysics::build_friction_map(std::uint64_t seed) {
+  friction_scale_.assign(f_.depth_mm.size(), 1.0);
+  if (gel_.friction_variation <= 0.0) return;
+  Rng rng(hash_combine(seed, 0xF71C7 + static_cast<std::uint64_t>(sensor_)));
+  double kx[3], ky[3], ph[3];
+  for (int q = 0; q < 3; ++q) {
+    const double k = 2.0 * std::numbers::pi / rng.uniform(4.0, 12.0);
+    const double dir = rng.uniform(0.0, 2.0 * std::numbers::pi);
+    kx[q] = k * std::cos(dir);
+    ky[q] = k * std::sin(dir);
+    ph[q] = rng.uniform(0.0, 2.0 * std::numbers::pi);
+  }
+  for (int j = 0; j < f_.gh; ++j) {
+    for (int i = 0; i < f_.gw; ++i) {
+      const double u = f_.u_mm[static_cast<std::size_t>(i)],
+                   v = f_.v_mm[static_cast<std::size_t>(j)];
+      double m = 0.0;
+      for (int q = 0; q < 3; ++q) m += std::cos(kx[q] * u + ky[q] * v + ph[q]) / 3.0;
+      friction_scale_[f_.index(i, j)] = 1.0 + gel_.friction_variation * m;
+    }
+  }
 }
 
 void PadPhysics::reset() noexcept {
@@ -110,6 +175,7 @@ void PadPhysics::reset() noexcept {
     std::fill(v->begin(), v->end(), 0.0);
   }
   std::fill(f_.contact.begin(), f_.contact.end(), std::uint8_t{0});
+  std::fill(capped_.begin(), capped_.end(), std::uint8_t{0});
   std::fill(f_.shade.begin(), f_.shade.end(), 1.0);
   labels_ = PadLabels{};
   has_last_ = false;
@@ -322,6 +388,76 @@ void PadPhysics::compute_normal() noexcept {
                                         shading_.press_gain_per_mm * static_cast<double>(phi[k]));
     }
   }
+  if (gel_.bulge_model == BulgeModel::kRadialVolume) radial_bulge();
+}
+
+// Incompressible layer of thickness h: the volume V(r) pressed down within radius r of the
+// patch's depth-weighted centre flows out through the cylinder of radius r, so the depth-mean
+// outward displacement is V(r) / (2 pi r h); the surface moves eta times that. Beyond the
+// patch the gel's finite extent damps it as exp(-(r - r_patch) / sigma). The shading keeps the
+// smoothed surface (the surface shape, not its in-plane flow, tilts it).
+void PadPhysics::radial_bulge() noexcept {
+  double mass = 0.0, cu = 0.0, cv = 0.0;
+  for (int j = 0; j < f_.gh; ++j) {
+    for (int i = 0; i < f_.gw; ++i) {
+      const double d = f_.depth_mm[f_.index(i, j)];
+      mass += d;
+      cu += d * f_.u_mm[static_cast<std::size_t>(i)];
+      cv += d * f_.v_mm[static_cast<std::size_t>(j)];
+    }
+  }
+  std::fill(f_.normal_x.begin(), f_.normal_x.end(), 0.0);
+  std::fill(f_.normal_y.begin(), f_.normal_y.end(), 0.0);
+  if (mass <= 0.0) return;
+  cu /= mass;
+  cv /= mass;
+  const double bin = 0.5 * f_.cell_mm, area = f_.cell_mm * f_.cell_mm;
+  const std::size_t nb = radial_mass_.size();
+  std::fill(radial_mass_.begin(), radial_mass_.end(), 0.0);
+  double r_patch = 0.0;
+  for (int j = 0; j < f_.gh; ++j) {
+    for (int i = 0; i < f_.gw; ++i) {
+      const double d = f_.depth_mm[f_.index(i, j)];
+      if (d <= 0.0) continue;
+      const double r = std::hypot(f_.u_mm[static_cast<std::size_t>(i)] - cu,
+                                  f_.v_mm[static_cast<std::size_t>(j)] - cv);
+      r_patch = std::max(r_patch, r);
+      radial_mass_[std::min(nb - 1, static_cast<std::size_t>(r / bin))] += d * area;
+    }
+  }
+  for (std::size_t b = 1; b < nb; ++b) radial_mass_[b] += radial_mass_[b - 1];  // V at bin ends
+  const double gain = gel_.bulge_surface_factor / (2.0 * std::numbers::pi * gel_.gel_thickness_mm);
+  for (int j = 0; j < f_.gh; ++j) {
+    for (int i = 0; i < f_.gw; ++i) {
+      const double du = f_.u_mm[static_cast<std::size_t>(i)] - cu;
+      const double dv = f_.v_mm[static_cast<std::size_t>(j)] - cv;
+      const double r = std::hypot(du, dv);
+      if (r < 1e-9) continue;
+      // V(r) interpolated between bin ends (bin b ends at (b + 1) * bin).
+      const double x = r / bin - 1.0;
+      double vol = radial_mass_[nb - 1];
+      if (x < 0.0) {
+        vol = radial_mass_[0] * (r / bin);
+      } else if (x < static_cast<double>(nb - 1)) {
+        const auto b = static_cast<std::size_t>(x);
+        vol = radial_mass_[b] +
+              (x - static_cast<double>(b)) * (radial_mass_[b + 1] - radial_mass_[b]);
+      }
+      const double damp = std::exp(-std::max(0.0, r - r_patch) / gel_.bulge_sigma_mm);
+      const double mag = gain * vol / r * damp;
+      f_.normal_x[f_.index(i, j)] = mag * du / r;
+      f_.normal_y[f_.index(i, j)] = mag * dv / r;
+    }
+  }
+}
+
+bool PadPhysics::cap(double* ux, double* uy, double umax) noexcept {
+  const double mag = std::hypot(*ux, *uy);
+  if (mag <= umax) return false;
+  const double scale = umax / mag;
+  *ux *= scale;
+  *uy *= scale;
+  return true;
 }
 
 void PadPhysics::compute_tangential(const Scenario& scn, const Pose& pose, double t, double dt,
@@ -356,34 +492,46 @@ void PadPhysics::compute_tangential(const Scenario& scn, const Pose& pose, doubl
       const Eigen::Vector3d vel = rpad_ * tw.velocity_at(c_g);
       f_.slide_vx[k] = static_cast<double>(vel.x());
       f_.slide_vy[k] = static_cast<double>(vel.y());
+      const double umax = umax_per_mm * static_cast<double>(f_.depth_mm[k]) * friction_scale_[k];
       if (!sliding) {
         // Stick: the gel point now at c was carried there by the object, from where the same
         // object point was before the motion (the pose is the identity before the motion).
         const Eigen::Vector3d disp = rpad_ * (c_g - pose.apply_inverse(c_g));
-        f_.tangential_x[k] = static_cast<double>(disp.x());
-        f_.tangential_y[k] = static_cast<double>(disp.y());
+        double ux = disp.x(), uy = disp.y();
+        // Coulomb rim: a stuck cell holds at most mu kappa d; the shallow rim reaches it first
+        // and slips there while the centre still sticks (Cattaneo-Mindlin partial slip).
+        capped_[k] = gel_.slide_law == SlideLaw::kCoulombRim && cap(&ux, &uy, umax) ? 1 : 0;
+        f_.tangential_x[k] = ux;
+        f_.tangential_y[k] = uy;
+        continue;
+      }
+      double ux = f_.tangential_x[k], uy = f_.tangential_y[k];
+      if (gel_.slide_law == SlideLaw::kTanh) {
+        // tau dU/dt = Umax tanh(c|v| / Umax) v/|v| - U: a smooth saturation, no hard cap.
+        for (int s = 0; s < nsub; ++s) {
+          const auto si = static_cast<std::size_t>(s);
+          const Eigen::Vector3d vs = rpad_ * (sub_w_[si].cross(c_g) + sub_v_[si]);
+          double tx = c * vs.x(), ty = c * vs.y();
+          const double mag = std::hypot(tx, ty);
+          const double scale = mag > 0.0 && umax > 0.0 ? umax * std::tanh(mag / umax) / mag : 0.0;
+          tx *= scale;
+          ty *= scale;
+          ux += (tx - ux) * decay;
+          uy += (ty - uy) * decay;
+        }
+        f_.tangential_x[k] = ux;
+        f_.tangential_y[k] = uy;
         continue;
       }
       // Slide: tau dU/dt = c v - U, integrated exactly per sub-step, then the Coulomb cap.
-      double ux = f_.tangential_x[k], uy = f_.tangential_y[k];
-      const double umax = umax_per_mm * static_cast<double>(f_.depth_mm[k]);
       for (int s = 0; s < nsub; ++s) {
         const auto si = static_cast<std::size_t>(s);
         const Eigen::Vector3d vs = rpad_ * (sub_w_[si].cross(c_g) + sub_v_[si]);
         ux += (c * vs.x() - ux) * decay;
         uy += (c * vs.y() - uy) * decay;
-        const double mag = std::hypot(ux, uy);
-        if (mag > umax) {
-          const double scale = umax / mag;
-          ux *= scale;
-          uy *= scale;
-        }
+        (void)cap(&ux, &uy, umax);
       }
-      const double mag = std::hypot(ux, uy);
-      if (mag > umax) {
-        ux *= umax / mag;
-        uy *= umax / mag;
-      }
+      (void)cap(&ux, &uy, umax);
       f_.tangential_x[k] = static_cast<double>(ux);
       f_.tangential_y[k] = static_cast<double>(uy);
     }
@@ -406,6 +554,10 @@ void PadPhysics::spread() noexcept {
 // lambda^2 lap(U) = U (screened Poisson), with U given on the patch and free (Neumann) image
 // borders. Red-black SOR, warm-started from the previous frame's values off the patch.
 int PadPhysics::spread_field(double* ux, double* uy) noexcept {
+  if (gel_.spread_kernel == SpreadKernel::kHalfSpace) {
+    halfspace_.apply(f_.contact.data(), ux, uy);
+    return 0;
+  }
   const int gw = f_.gw, gh = f_.gh;
   const double alpha = static_cast<double>(std::pow(f_.cell_mm / gel_.spread_length_mm, 2.0));
   const auto omega = static_cast<double>(kSorOmega);
@@ -470,7 +622,7 @@ void PadPhysics::compute_labels(bool sliding) noexcept {
       peak = std::max(peak, static_cast<double>(f_.depth_mm[k]));
       const double vx = f_.slide_vx[k], vy = f_.slide_vy[k];
       const double v2 = vx * vx + vy * vy;
-      if (sliding && v2 > thr2) ++slipping;
+      if ((sliding && v2 > thr2) || (!sliding && capped_[k])) ++slipping;
     }
   }
   labels_.in_contact = count > 0;

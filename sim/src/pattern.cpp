@@ -79,6 +79,10 @@ void Pattern::build(const PatternSpec& spec, double pixel_pitch_mm, int width, i
         d.rgb[c] =
             std::min(1.0f, static_cast<float>(static_cast<double>(kPalette[colour][c]) * shade));
       }
+      if (spec.grey_dots) {
+        const float luma = 0.299f * d.rgb[0] + 0.587f * d.rgb[1] + 0.114f * d.rgb[2];
+        d.rgb[0] = d.rgb[1] = d.rgb[2] = luma;
+      }
     }
   }
 

@@ -34,7 +34,8 @@ double nominal_finger_separation(const SimConfig& config, std::string* error) {
   double sum = 0.0;
   for (int s = 0; s < kSensorCount; ++s) {
     PadPhysics pad;
-    pad.build(static_cast<Sensor>(s), config.rig, config.gel, config.camera.shading);
+    pad.build(static_cast<Sensor>(s), config.rig, config.gel, config.camera.shading,
+              hash_combine(config.seed, 0xF7 + static_cast<std::uint64_t>(s)));
     pad.step(scn, shape, scn.grasp_end_s());
     if (!pad.labels().in_contact) {
       if (error) {
@@ -64,7 +65,8 @@ std::unique_ptr<Simulator> Simulator::create(const SimConfig& config, std::strin
   for (int s = 0; s < kSensorCount; ++s) {
     const auto sensor = static_cast<Sensor>(s);
     const auto k = static_cast<std::size_t>(s);
-    sim->pads_[k].build(sensor, config.rig, config.gel, config.camera.shading);
+    sim->pads_[k].build(sensor, config.rig, config.gel, config.camera.shading,
+                        hash_combine(config.seed, 0xF7 + static_cast<std::uint64_t>(s)));
     if (!config.sensors[k] || !config.images) continue;
     const std::uint64_t seed = hash_combine(config.seed, 0x5E45 + static_cast<std::uint64_t>(s));
     sim->patterns_[k].build(config.pattern, config.rig.pixel_pitch_mm, config.rig.width,
@@ -86,7 +88,10 @@ SimStatus Simulator::render(Sensor s, std::int64_t t_ns, std::span<std::uint8_t>
   }
   const SimStatus st = step(s, t_ns);
   if (st != SimStatus::kOk) return st;
-  cameras_[idx(s)].render(patterns_[idx(s)], pads_[idx(s)].fields(), t_ns, out.data(), channels);
+  if (!cameras_[idx(s)].render(patterns_[idx(s)], pads_[idx(s)].fields(), t_ns, out.data(),
+                               channels)) {
+    return SimStatus::kCodecFailed;
+  }
   return SimStatus::kOk;
 }
 

@@ -7,6 +7,7 @@
 #include <new>
 #include <vector>
 
+#include "tacse3/sim/profile.hpp"
 #include "tacse3/sim/simulator.hpp"
 
 // GCC 12 flags free() in a replaced operator delete as mismatched once inlined; the pair
@@ -64,6 +65,38 @@ TEST(SimAlloc, StepAndRenderDoNotAllocate) {
     g_counting = false;
     EXPECT_EQ(g_allocations.load(), 0) << to_string(regime);
     EXPECT_TRUE(sim->labels(Sensor::kLeft).in_contact);
+  }
+}
+
+// Every profile's models (radial bulge, tanh and Coulomb-rim laws, friction map, half-space
+// spread, MJPEG camera) allocate in create() only. libjpeg's own per-image pools are C malloc
+// inside libturbojpeg, outside this count.
+TEST(SimAlloc, ProfilesStepAndRenderDoNotAllocate) {
+  for (const char* name :
+       {"soft-thick", "stiff-thin", "coulomb-rim", "halfspace-mjpeg", "random"}) {
+    for (Regime regime : {Regime::kSlide, Regime::kStick}) {
+      SensorProfile p;
+      ASSERT_TRUE(make_profile(name, 5, &p, nullptr));
+      SimConfig c;
+      c.scenario.axis = MotionAxis::kRz;
+      c.scenario.magnitude = regime == Regime::kSlide ? 20.0 : 3.0;
+      c.scenario.regime = regime;
+      apply_profile(p, &c);
+      std::string error;
+      auto sim = Simulator::create(c, &error);
+      ASSERT_TRUE(sim) << error;
+      std::vector<std::uint8_t> rgb(sim->frame_bytes(3)), grey(sim->frame_bytes(1));
+      const Scenario& scn = sim->scenario();
+      g_allocations = 0;
+      g_counting = true;
+      for (int i = 0; i < scn.frame_count(); i += 12) {
+        const std::int64_t t = scn.frame_time_ns(i);
+        ASSERT_EQ(sim->render(Sensor::kLeft, t, rgb, 3), SimStatus::kOk);
+        ASSERT_EQ(sim->render(Sensor::kRight, t, grey, 1), SimStatus::kOk);
+      }
+      g_counting = false;
+      EXPECT_EQ(g_allocations.load(), 0) << name << " " << to_string(regime);
+    }
   }
 }
 

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -12,6 +13,7 @@
 
 #include "options.hpp"
 #include "tacse3/recording/recording.hpp"
+#include "tacse3/sim/profile.hpp"
 #include "tacse3/sim/simulator.hpp"
 #include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/progress.hpp"
@@ -29,6 +31,42 @@ int fail(const std::string& msg) {
   return 1;
 }
 
+int usage_error(const std::string& msg) {
+  std::fprintf(stderr, "tacse3-sim: error: %s\n", msg.c_str());
+  return 2;
+}
+
+// --profile list: every profile's name and values (the random one's for this --seed).
+int list_profiles(std::uint64_t seed) {
+  for (const char* name :
+       {"reference", "soft-thick", "stiff-thin", "coulomb-rim", "halfspace-mjpeg", "random"}) {
+    sim::SensorProfile p;
+    if (!sim::make_profile(name, seed, &p, nullptr)) return fail(std::string("no profile ") + name);
+    std::printf("%s\n", name);
+    for (const auto& [key, value] : sim::profile_values(p)) {
+      std::printf("  %s = %s\n", key.c_str(), value.c_str());
+    }
+  }
+  return 0;
+}
+
+// The profile's values for recording.json: numbers as numbers, model names as strings.
+nlohmann::ordered_json profile_json(const sim::SensorProfile& p) {
+  nlohmann::ordered_json values = nlohmann::ordered_json::object();
+  for (const auto& [key, value] : sim::profile_values(p)) {
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (value == "true" || value == "false") {
+      values[key] = value == "true";
+    } else if (end && *end == '\0' && end != value.c_str()) {
+      values[key] = v;
+    } else {
+      values[key] = value;
+    }
+  }
+  return values;
+}
+
 std::string command_line(int argc, char** argv) {
   std::string s;
   for (int i = 0; i < argc; ++i) {
@@ -41,6 +79,8 @@ std::string command_line(int argc, char** argv) {
 int run(int argc, char** argv) {
   Options o;
   if (const int rc = parse_options(argc, argv, &o); rc >= 0) return rc;
+  if (o.profile == "list") return list_profiles(o.seed);
+  if (o.out.empty()) return usage_error("--out is required");
 
   sim::SimConfig cfg;
   cfg.seed = o.seed;
@@ -57,20 +97,31 @@ int run(int argc, char** argv) {
   }
   const bool rotation = sim::is_rotation(cfg.scenario.axis);
   cfg.scenario.magnitude = std::isnan(o.magnitude) ? (rotation ? 30.0 : 10.0) : o.magnitude;
-  cfg.scenario.indentation_mm = o.indentation;
+  // The profile first (it sets the motion duration from the magnitude), then the options the
+  // user gave explicitly.
+  sim::SensorProfile profile;
+  std::string profile_error;
+  if (!sim::make_profile(o.profile, o.seed, &profile, &profile_error)) {
+    return usage_error("--profile: " + profile_error);
+  }
+  if (std::string e = sim::validate(profile); !e.empty()) {
+    return fail("--profile " + o.profile + ": " + e);
+  }
+  sim::apply_profile(profile, &cfg);
   cfg.scenario.approach_s = o.approach_s;
   cfg.scenario.grasp_s = o.grasp_s;
   cfg.scenario.settle_s = o.settle_s;
-  cfg.scenario.motion_s = o.motion_s;
+  if (o.motion_s > 0.0) cfg.scenario.motion_s = o.motion_s;
   cfg.scenario.hold_s = o.hold_s;
   cfg.scenario.release_s = o.release_s;
   cfg.scenario.fps = o.fps;
+  if (!std::isnan(o.indentation)) cfg.scenario.indentation_mm = o.indentation;
   if (!std::isnan(o.radius)) cfg.scenario.object.size_mm = o.radius;
   if (!std::isnan(o.friction)) cfg.scenario.object.friction = o.friction;
   if (o.offset.size() == 2) cfg.scenario.object.offset_mm = {o.offset[0], o.offset[1]};
-  cfg.rig.pixel_pitch_mm = o.pitch;
-  cfg.camera.noise = o.noise;
-  cfg.camera.flicker = o.flicker;
+  if (!std::isnan(o.pitch)) cfg.rig.pixel_pitch_mm = o.pitch;
+  if (!std::isnan(o.noise)) cfg.camera.noise = o.noise;
+  if (!std::isnan(o.flicker)) cfg.camera.flicker = o.flicker;
   std::vector<sim::Sensor> sensors;
   if (o.sensors == "both") {
     sensors = {sim::Sensor::kLeft, sim::Sensor::kRight};
@@ -125,6 +176,7 @@ int run(int argc, char** argv) {
                  {"regime_requested", sim::to_string(cfg.scenario.regime)},
                  {"indentation_mm", cfg.scenario.indentation_mm},
                  {"seed", o.seed},
+                 {"profile", {{"name", profile.name}, {"values", profile_json(profile)}}},
                  {"noise", cfg.camera.noise},
                  {"flicker", cfg.camera.flicker},
                  {"grasp_end_ns", std::llround(scn.grasp_end_s() * 1e9)},
@@ -136,7 +188,8 @@ int run(int argc, char** argv) {
                    {"bulge_sigma_mm", cfg.gel.bulge_sigma_mm},
                    {"drag_time_s", cfg.gel.drag_time_s},
                    {"lag_time_s", cfg.gel.lag_time_s},
-                   {"shear_compliance", cfg.gel.shear_compliance}}}};
+                   {"shear_compliance", cfg.gel.shear_compliance}}},
+                 {"mjpeg_quality", cfg.camera.mjpeg_quality}};
   info.extra_json = meta.dump();
 
   rec::WriterOptions wopt;

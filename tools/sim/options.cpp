@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "tacse3/sim/object.hpp"
+#include "tacse3/sim/profile.hpp"
 #include "tacse3/tools/cli.hpp"
 
 namespace tacse3::tools {
@@ -15,8 +16,7 @@ int parse_options(int argc, char** argv, Options* o) {
       "tacse3-sim: render a simulated grasp of an object between two mirrored DM-Tac sensors,\n"
       "then a commanded motion and a hold, as a recording directory with truth.csv\n"
       "(docs/simulator.md, docs/recording-format.md)."};
-  app.add_option("-o,--out", o->out, "Output recording directory")
-      ->required()
+  app.add_option("-o,--out", o->out, "Output recording directory (required unless --profile list)")
       ->check(non_empty_path());
   app.add_option("--object", o->object,
                  std::string("Object preset: ") + tacse3::sim::object_preset_names())
@@ -30,21 +30,25 @@ int parse_options(int argc, char** argv, Options* o) {
   app.add_option("--regime", o->regime,
                  "Tangential regime: stick, slide, or auto (stick up to 5 deg / 1 mm)")
       ->capture_default_str();
-  app.add_option("--seed", o->seed, "Seed of the pattern, noise, flicker and bumpy shape")
+  app.add_option("--profile", o->profile,
+                 std::string("Sensor profile (docs/sim-profiles.md): ") +
+                     tacse3::sim::profile_names() + "; \"list\" prints them with their values")
       ->capture_default_str();
-  app.add_option("--noise", o->noise, "Sensor noise multiplier (0 = noiseless)")
+  app.add_option("--seed", o->seed,
+                 "Seed of the pattern, noise, flicker, bumpy shape and the random profile")
       ->capture_default_str();
-  app.add_option("--flicker", o->flicker, "Peak per-frame global gain flicker (0.02 = +-2%)")
-      ->capture_default_str();
+  app.add_option("--noise", o->noise, "Sensor noise multiplier, 0 = noiseless (default 1)");
+  app.add_option("--flicker", o->flicker,
+                 "Peak per-frame global gain flicker, 0.02 = +-2% (default: the profile's)");
   auto* radius = app.add_option(
       "--radius", o->radius, "Object size in mm: half-width along the grasp axis (preset default)");
   app.add_option("--finger-separation", o->separation,
                  "Scale the object so the pads end the grasp this far apart (mm)")
       ->excludes(radius);
-  app.add_option("--indentation", o->indentation, "Peak gel indentation after the grasp (mm)")
-      ->capture_default_str();
-  app.add_option("--pixel-pitch", o->pitch, "Pixel pitch P on the pad (mm/px)")
-      ->capture_default_str();
+  app.add_option("--indentation", o->indentation,
+                 "Peak gel indentation after the grasp in mm (default: the profile's)");
+  app.add_option("--pixel-pitch", o->pitch,
+                 "Pixel pitch P on the pad in mm/px (default: the profile's)");
   app.add_option("--friction", o->friction, "Object-gel friction coefficient (preset default)");
   app.add_option("--offset", o->offset, "Object centre offset in G x y at the first frame (mm)")
       ->expected(2);
@@ -53,7 +57,8 @@ int parse_options(int argc, char** argv, Options* o) {
       ->capture_default_str();
   app.add_option("--settle-s", o->settle_s, "Static grasp before the motion (s)")
       ->capture_default_str();
-  app.add_option("--motion-s", o->motion_s, "Motion duration (s); 0 = auto from the magnitude")
+  app.add_option("--motion-s", o->motion_s,
+                 "Motion duration (s); 0 = the profile's speed, or auto from the magnitude")
       ->capture_default_str();
   app.add_option("--hold-s", o->hold_s, "Static hold after the motion (s)")->capture_default_str();
   app.add_option("--release-s", o->release_s,

@@ -16,12 +16,14 @@ struct Options {
   double magnitude = NAN;
   std::string regime = "auto";
   std::uint64_t seed = 1;
-  double noise = 1.0;
-  double flicker = 0.02;
+  std::string profile = "reference";
+  // NaN: the profile's value.
+  double noise = NAN;
+  double flicker = NAN;
   double radius = NAN;
   double separation = NAN;
-  double indentation = 1.0;
-  double pitch = 0.1;
+  double indentation = NAN;
+  double pitch = NAN;
   double friction = NAN;
   std::vector<double> offset;
   double approach_s = 0.1, grasp_s = 0.4, settle_s = 0.1, motion_s = 0.0, hold_s = 0.4;

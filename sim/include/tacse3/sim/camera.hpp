@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "tacse3/sim/mjpeg.hpp"
 #include "tacse3/sim/pad.hpp"
 #include "tacse3/sim/pattern.hpp"
 #include "tacse3/sim/types.hpp"
@@ -25,6 +26,9 @@ struct CameraSpec {
   double noise = 1.0;              // multiplier on shot + read noise; 0 = noiseless
   double electrons_per_dn = 20.0;  // conversion gain: shot-noise variance = DN / this
   double read_noise_dn = 1.0;
+  // 0: frames as rendered. 1..100: each frame is JPEG-compressed at this quality and decoded, as
+  // a UVC camera's MJPEG stream is (docs/sim-profiles.md).
+  int mjpeg_quality = 0;
 };
 
 std::string validate(const CameraSpec& spec);
@@ -41,8 +45,9 @@ class Camera {
   // Renders width x height pixels, `channels` = 3 (RGB888) or 1 (GREY, BT.601 luma), tightly
   // packed into out. The gel material seen at pixel x came from x - total(x) (fields in mm,
   // bilinearly interpolated from the physics grid); its pattern colour is scaled by the
-  // illumination, shading and flicker, then shot and read noise are added.
-  void render(const Pattern& pattern, const PadFields& fields, std::int64_t t_ns, std::uint8_t* out,
+  // illumination, shading and flicker, then shot and read noise are added; an MJPEG camera
+  // then compresses and decodes the frame. False if that round trip failed.
+  bool render(const Pattern& pattern, const PadFields& fields, std::int64_t t_ns, std::uint8_t* out,
               int channels) noexcept;
 
   const RigSpec& rig() const noexcept { return rig_; }
@@ -60,6 +65,7 @@ class Camera {
   std::vector<float> noise_line_;             // one image row of standard normal draws, w * 3
   std::vector<float> sigma_;                  // noise sigma per DN level
   std::vector<float> normal_;                 // standard normal quantiles (65536)
+  MjpegCodec mjpeg_;
 };
 
 }  // namespace tacse3::sim

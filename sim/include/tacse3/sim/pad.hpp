@@ -11,12 +11,36 @@
 
 #include "tacse3/sim/object.hpp"
 #include "tacse3/sim/scenario.hpp"
+#include "tacse3/sim/spread.hpp"
 #include "tacse3/sim/types.hpp"
 
 namespace tacse3::sim {
 
+// Modelling choices of the gel (docs/sim-profiles.md). The first value of each is the reference
+// physics of docs/simulator.md.
+enum class BulgeModel : std::uint8_t {
+  kSmoothedGradient = 0,  // U_n = -k grad(G_sigma * d)
+  kRadialVolume,          // incompressible layer: displaced volume flows radially outward
+};
+enum class SlideLaw : std::uint8_t {
+  kViscousCapped = 0,  // tau dU/dt = c v - U, |U| <= mu kappa d
+  kTanh,               // tau dU/dt = Umax tanh(c|v| / Umax) v/|v| - U
+  kCoulombRim,         // viscous slide; a stuck cell is capped too, so the rim slips first
+};
+enum class SpreadKernel : std::uint8_t {
+  kThinLayer = 0,  // screened Poisson (exponential decay), thin layer on a rigid backing
+  kHalfSpace,      // rigid-punch elastic half-space (1/r far field), bounded by the thickness
+};
+
+const char* to_string(BulgeModel m) noexcept;
+const char* to_string(SlideLaw m) noexcept;
+const char* to_string(SpreadKernel m) noexcept;
+
 // Mechanical parameters of the gel (docs/simulator.md, "Contact mechanics").
 struct GelSpec {
+  BulgeModel bulge_model = BulgeModel::kSmoothedGradient;
+  SlideLaw slide_law = SlideLaw::kViscousCapped;
+  SpreadKernel spread_kernel = SpreadKernel::kThinLayer;
   // Thin-layer decay length of tangential displacement outside the patch (~ gel thickness).
   double spread_length_mm = 2.0;
   // Normal response: in-plane bulge U_n = -bulge_gain * grad(G_sigma * d).
@@ -26,6 +50,12 @@ struct GelSpec {
   double drag_time_s = 0.05;      // c: steady shear displacement per unit sliding speed (s)
   double lag_time_s = 0.06;       // tau: first-order lag (s); the derivation gives tau >= c
   double shear_compliance = 1.5;  // kappa: shear displacement per unit friction-limited traction
+  // Radial-volume bulge: U_n(r) = eta V(r) / (2 pi r h), decaying as exp(-(r - r_patch) / sigma)
+  // beyond the patch (bulge_sigma_mm is then the extent).
+  double bulge_surface_factor = 1.0;  // eta: surface over depth-mean outward displacement
+  double gel_thickness_mm = 2.0;      // h
+  // Relative amplitude of a smooth friction map over the pad: mu(x) = mu (1 + a m(x)), |m| <= 1.
+  double friction_variation = 0.0;
   // Labels: a contact cell counts as slipping when its sliding speed exceeds this (mm/s).
   double slip_speed_mm_s = 0.5;
 };
@@ -74,16 +104,18 @@ struct PadLabels {
   double area_mm2 = 0.0;
   Eigen::Vector2d centroid_mm = Eigen::Vector2d::Zero();  // pad frame (u, v)
   double peak_depth_mm = 0.0;
-  double slip_fraction = 0.0;  // share of contact cells sliding (always 0 in the stick regime)
+  double slip_fraction = 0.0;  // share of contact cells sliding (stick: cells at the Coulomb cap)
   bool slipping = false;       // slip_fraction > 0.5
   int trace_sdf_evals = 0;     // cost counter of the last contact computation
-  int spread_sweeps = 0;       // SOR sweeps used by the last spreading solve
+  int spread_sweeps = 0;       // SOR sweeps used by the last spreading solve (0: half-space)
 };
 
 // One pad's mechanics. build() allocates everything; step() is allocation-free.
 class PadPhysics {
  public:
-  void build(Sensor sensor, const RigSpec& rig, const GelSpec& gel, const ShadingSpec& shading);
+  // seed draws the friction map (gel.friction_variation > 0); it is unused otherwise.
+  void build(Sensor sensor, const RigSpec& rig, const GelSpec& gel, const ShadingSpec& shading,
+             std::uint64_t seed = 0);
   void reset() noexcept;
   // Advances the pad to time t (seconds, non-decreasing since the last reset).
   SimStatus step(const Scenario& scenario, const Shape& shape, double t) noexcept;
@@ -102,6 +134,10 @@ class PadPhysics {
  private:
   bool compute_contact(const Scenario& scn, const Shape& shape, double t, double dt) noexcept;
   void compute_normal() noexcept;
+  void radial_bulge() noexcept;
+  void build_friction_map(std::uint64_t seed);
+  // Scales (ux, uy) down to length umax if longer; true if it did.
+  static bool cap(double* ux, double* uy, double umax) noexcept;
   void compute_tangential(const Scenario& scn, const Pose& pose, double t, double dt,
                           double umax_per_mm) noexcept;
   void spread() noexcept;
@@ -120,7 +156,11 @@ class PadPhysics {
   PadLabels labels_;
   std::vector<double> gauss_;  // 1-D kernel, radius gauss_radius_
   int gauss_radius_ = 0;
-  std::vector<double> scratch_;  // separable blur pass
+  std::vector<double> scratch_;         // separable blur pass
+  std::vector<double> friction_scale_;  // 1 + a m(x) per cell
+  std::vector<std::uint8_t> capped_;    // stuck cell held at its friction cap (partial slip)
+  std::vector<double> radial_mass_;     // radial-volume bulge: displaced volume per ring
+  HalfSpaceSpread halfspace_;
   bool has_last_ = false;
   bool bond_captured_ = false;  // bonded_normal holds the bulge the bond started from
   bool has_height_ = false;

@@ -20,6 +20,7 @@ struct PatternSpec {
   double background = 0.5;   // grey gel reflectance (linear, 0..1)
   int supersample = 3;       // texels per pixel of the precomputed texture
   int margin_px = 48;        // texture margin around the image (largest displacement)
+  bool grey_dots = false;    // dots printed in grey levels (each ink's luma) instead of colours
 };
 
 // Empty string if usable, else a message naming the field.

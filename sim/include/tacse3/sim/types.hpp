@@ -71,6 +71,7 @@ enum class SimStatus : std::uint8_t {
   kOk = 0,
   kBadBuffer,      // output span too small or channel count not 1 or 3
   kTimeBackwards,  // t earlier than the last step of that sensor (call reset() first)
+  kCodecFailed,    // the MJPEG round trip of the frame failed
 };
 
 constexpr const char* to_string(SimStatus s) noexcept {
@@ -81,6 +82,8 @@ constexpr const char* to_string(SimStatus s) noexcept {
       return "output buffer too small or unsupported channel count";
     case SimStatus::kTimeBackwards:
       return "time earlier than the previous step of this sensor; call reset() first";
+    case SimStatus::kCodecFailed:
+      return "the MJPEG round trip of the frame failed";
   }
   return "unknown status";
 }
