@@ -64,7 +64,7 @@ SensorProfile soft_thick() {
   p.name = "soft-thick";
   GelSpec& g = p.gel;
   g.bulge_model = BulgeModel::kRadialVolume;
-  g.bulge_surface_factor = 1.2;
+  g.bulge_surface_factor = 1.0;
   g.gel_thickness_mm = 4.0;
   g.bulge_sigma_mm = 2.0;
   g.slide_law = SlideLaw::kTanh;
@@ -151,10 +151,10 @@ SensorProfile random_profile(std::uint64_t seed) {
   Rng rng(hash_combine(seed, 0x9F0F11E));
   GelSpec& g = p.gel;
   g.bulge_model = rng.uniform() < 0.5 ? BulgeModel::kSmoothedGradient : BulgeModel::kRadialVolume;
-  g.bulge_gain_mm = rng.uniform(0.6, 3.0);
+  g.bulge_gain_mm = rng.uniform(1.4, 3.8);
   g.bulge_sigma_mm = rng.uniform(0.5, 2.0);
-  g.bulge_surface_factor = rng.uniform(0.5, 1.5);
-  g.gel_thickness_mm = rng.uniform(1.0, 4.0);
+  g.bulge_surface_factor = rng.uniform(0.5, 1.0);
+  g.gel_thickness_mm = rng.uniform(1.75, 4.0);
   g.slide_law = static_cast<SlideLaw>(static_cast<int>(rng.uniform() * 3.0));
   g.drag_time_s = rng.uniform(0.005, 0.05);
   g.lag_time_s = rng.uniform(0.001, 0.05);
@@ -181,7 +181,7 @@ SensorProfile random_profile(std::uint64_t seed) {
 
 std::string number(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
+  std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
 }
 

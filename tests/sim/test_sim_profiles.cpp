@@ -139,13 +139,13 @@ TEST(SimProfiles, RandomProfileStaysInItsRanges) {
     slide.insert(g.slide_law);
     spread.insert(g.spread_kernel);
     grey.insert(p.pattern.grey_dots);
-    EXPECT_GE(g.bulge_gain_mm, 0.6);
-    EXPECT_LE(g.bulge_gain_mm, 3.0);
+    EXPECT_GE(g.bulge_gain_mm, 1.4);
+    EXPECT_LE(g.bulge_gain_mm, 3.8);
     EXPECT_GE(g.bulge_sigma_mm, 0.5);
     EXPECT_LE(g.bulge_sigma_mm, 2.0);
     EXPECT_GE(g.bulge_surface_factor, 0.5);
-    EXPECT_LE(g.bulge_surface_factor, 1.5);
-    EXPECT_GE(g.gel_thickness_mm, 1.0);
+    EXPECT_LE(g.bulge_surface_factor, 1.0);
+    EXPECT_GE(g.gel_thickness_mm, 1.75);
     EXPECT_LE(g.gel_thickness_mm, 4.0);
     EXPECT_GE(g.drag_time_s, 0.005);
     EXPECT_LE(g.drag_time_s, 0.05);
@@ -193,6 +193,46 @@ TEST(SimProfiles, RandomProfileStaysInItsRanges) {
   EXPECT_EQ(slide.size(), 3u);
   EXPECT_EQ(spread.size(), 2u);
   EXPECT_EQ(grey.size(), 2u);
+}
+
+// Peak in-plane bulge |U_n| of a 20 mm sphere pressed 1 mm into the pad.
+double bulge_amplitude_mm(const GelSpec& gel) {
+  SimConfig c;
+  c.gel = gel;
+  c.images = false;
+  auto sim = make(c);
+  if (!sim) return -1.0;
+  EXPECT_EQ(sim->step(Sensor::kLeft, ns(sim->scenario().grasp_end_s())), SimStatus::kOk);
+  const PadFields& f = sim->fields(Sensor::kLeft);
+  double peak = 0.0;
+  for (std::size_t k = 0; k < f.normal_x.size(); ++k) {
+    peak = std::max(peak, std::hypot(f.normal_x[k], f.normal_y[k]));
+  }
+  return peak;
+}
+
+// The bulge amplitude a DM-Tac-class gel shows, 0.2-1.0 mm for that sphere (docs/sim-profiles.md):
+// the named profiles and the random profile's extremes of both bulge models stay in it.
+TEST(SimProfiles, BulgeAmplitudeStaysInItsRange) {
+  for (const char* name : kNamed) {
+    const double a = bulge_amplitude_mm(profile(name).gel);
+    EXPECT_GE(a, 0.2 - 0.005) << name;
+    EXPECT_LE(a, 1.0) << name;
+  }
+  GelSpec g;
+  g.bulge_gain_mm = 1.4;  // smallest gain, widest smoothing
+  g.bulge_sigma_mm = 2.0;
+  EXPECT_NEAR(bulge_amplitude_mm(g), 0.2, 0.01);
+  g.bulge_gain_mm = 3.8;  // largest gain, narrowest smoothing
+  g.bulge_sigma_mm = 0.5;
+  EXPECT_NEAR(bulge_amplitude_mm(g), 1.0, 0.01);
+  g.bulge_model = BulgeModel::kRadialVolume;
+  g.bulge_surface_factor = 0.5;  // weakest flow, thickest gel
+  g.gel_thickness_mm = 4.0;
+  EXPECT_NEAR(bulge_amplitude_mm(g), 0.2, 0.02);
+  g.bulge_surface_factor = 1.0;  // strongest flow, thinnest gel
+  g.gel_thickness_mm = 1.75;
+  EXPECT_NEAR(bulge_amplitude_mm(g), 1.0, 0.02);
 }
 
 TEST(SimProfiles, SpeedSetsTheMotionDuration) {

@@ -59,7 +59,11 @@ nlohmann::ordered_json profile_json(const sim::SensorProfile& p) {
     if (value == "true" || value == "false") {
       values[key] = value == "true";
     } else if (end && *end == '\0' && end != value.c_str()) {
-      values[key] = v;
+      if (v == std::floor(v) && std::abs(v) < 1e15) {
+        values[key] = static_cast<std::int64_t>(v);
+      } else {
+        values[key] = v;
+      }
     } else {
       values[key] = value;
     }
@@ -80,7 +84,6 @@ int run(int argc, char** argv) {
   Options o;
   if (const int rc = parse_options(argc, argv, &o); rc >= 0) return rc;
   if (o.profile == "list") return list_profiles(o.seed);
-  if (o.out.empty()) return usage_error("--out is required");
 
   sim::SimConfig cfg;
   cfg.seed = o.seed;
@@ -107,6 +110,7 @@ int run(int argc, char** argv) {
   if (std::string e = sim::validate(profile); !e.empty()) {
     return fail("--profile " + o.profile + ": " + e);
   }
+  if (o.out.empty()) return usage_error("--out is required");
   sim::apply_profile(profile, &cfg);
   cfg.scenario.approach_s = o.approach_s;
   cfg.scenario.grasp_s = o.grasp_s;
