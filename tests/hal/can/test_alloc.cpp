@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 hal/can: send() and service() allocate nothing after open, in every TX situation.
+// tacse3 hal/can: send() and service() allocate nothing after open, in every TX situation, for
+// the SocketCAN and the Unix socket backends.
 #include <gtest/gtest.h>
 #include <linux/can/error.h>
+#include <unistd.h>
+
+#include <string>
 
 #include "alloc/alloc_hooks.hpp"
 #include "channel_fixture.hpp"
+#include "tacse3/hal/can/unix_channel.hpp"
 
 namespace can = tacse3::hal::can;
 using tacse3::test::allocation_count;
@@ -64,4 +69,53 @@ TEST(SocketCanAlloc, SendAndServiceAllocateNothingAfterOpen) {
   EXPECT_EQ(s.tx_errors, 16u + 99u);
   EXPECT_GT(s.tx_dropped, 0u);
   EXPECT_GT(ch->counters().enobufs, 0u);
+}
+
+// The Unix socket backend on the daemon's paths: send/service with a reading peer, a peer that
+// stops reading (frames dropped), and a peer that hangs up (released by service, closed by
+// receive); receive parsing a command line. Only connecting (in the test) allocates.
+TEST(UnixSocketChannelAlloc, SendServiceAndReceiveAllocateNothingAfterOpen) {
+  const std::string path = "/tmp/tacse3-unixcan-alloc-" + std::to_string(getpid()) + ".sock";
+  std::string e;
+  auto server = can::UnixSocketChannel::listen(path, e);
+  ASSERT_NE(server, nullptr) << e;
+  auto reader = can::UnixSocketChannel::connect(path, e);
+  auto stalled = can::UnixSocketChannel::connect(path, e);
+  auto leaving = can::UnixSocketChannel::connect(path, e);
+  ASSERT_TRUE(reader && stalled && leaving) << e;
+  can::RxFrame rx;
+  for (int i = 0; i < 5; ++i) (void)server->receive(rx, 5);  // accept the three
+  ASSERT_EQ(server->counters().peers, 3u);
+  can::CanFrame cmd;
+  cmd.id = 0x030;
+  cmd.len = 1;
+  ASSERT_TRUE(leaving->send(cmd));
+
+  reset_allocation_count();
+  std::uint32_t n = 0;
+  for (int i = 0; i < 2000; ++i) {  // ~40 cycles' worth per drain: the stalled peer fills up
+    for (std::uint32_t k = 0; k < 5; ++k) ASSERT_TRUE(server->send(numbered_frame(n++)));
+    server->service();
+    if (i % 50 == 0) {
+      while (reader->receive(rx, 0) == can::RxResult::kFrame) {
+      }
+    }
+  }
+  ASSERT_EQ(server->receive(rx, 100), can::RxResult::kFrame);  // the leaving peer's command
+  EXPECT_EQ(rx.frame.id, 0x030u);
+  const std::uint64_t before_leave = allocation_count();
+  EXPECT_EQ(before_leave, 0u);
+  leaving.reset();  // the destructor's free() is the test's, not the channel's
+  reset_allocation_count();
+  for (int i = 0; i < 20; ++i) {
+    ASSERT_TRUE(server->send(numbered_frame(n++)));
+    server->service();
+    (void)server->receive(rx, 2);
+  }
+  (void)server->stats();
+  (void)server->counters();
+  EXPECT_EQ(allocation_count(), 0u);
+  EXPECT_EQ(server->counters().disconnected, 1u);
+  EXPECT_EQ(server->counters().peers, 2u);
+  EXPECT_GT(server->stats().tx_dropped, 0u);  // the stalled peer's
 }
