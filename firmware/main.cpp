@@ -88,11 +88,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (opt.verbosity > 0) {
+    const std::string can = !opt.can_socket.empty() ? std::string("socket ") + opt.can_socket
+                            : board.can.backend == config::CanBackend::kLog
+                                ? std::string("log ") + board.can.log
+                                : std::string("socketcan ") + board.can.interface;
     std::fprintf(stderr, "tacse3d: board %s (%s), calibration %s, CAN %s\n", board.name.c_str(),
-                 board_file.c_str(), cal.file.empty() ? "built-in" : cal.file.c_str(),
-                 board.can.backend == config::CanBackend::kLog
-                     ? ("log " + board.can.log).c_str()
-                     : ("socketcan " + board.can.interface).c_str());
+                 board_file.c_str(), cal.file.empty() ? "built-in" : cal.file.c_str(), can.c_str());
   }
   return daemon->run(true);
 }

@@ -11,11 +11,14 @@ namespace tacse3::firmware {
 
 const char* usage_text() noexcept {
   return "usage: tacse3d --board NAME|PATH [--calibration FILE] [--can-log FILE|-]\n"
-         "               [--can-iface IFACE] [--seconds S] [--record DIR] [--check]\n"
-         "               [--quiet|--verbose]\n"
+         "               [--can-socket PATH] [--can-iface IFACE] [--seconds S] [--record DIR]\n"
+         "               [--check] [--quiet|--verbose]\n"
          "  --board NAME|PATH    board name (boards/NAME/board.toml) or a board.toml path\n"
          "  --calibration FILE   calibration from tacse3-calibrate (default: built-in)\n"
          "  --can-log FILE|-     write CAN frames as a candump -L log (\"-\" = stdout)\n"
+         "  --can-socket PATH    listen on a Unix socket: frames out and commands in as candump "
+         "-L\n"
+         "                       lines (tacse3-ctl --socket PATH); for hosts without CAN\n"
          "  --can-iface IFACE    override the board's SocketCAN interface\n"
          "  --seconds S          stop after S seconds of streaming (0 = until SIGTERM/SIGINT)\n"
          "  --record DIR         record both raw sensor streams to DIR\n"
@@ -68,6 +71,12 @@ bool parse_cli(int argc, const char* const* argv, Options* out, std::string* err
         *error = "--can-log needs a file or -";
         return false;
       }
+    } else if (name == "--can-socket") {
+      if (!take(&o.can_socket)) return false;
+      if (o.can_socket.empty()) {
+        *error = "--can-socket needs a socket path, e.g. /tmp/tacse3-can.sock";
+        return false;
+      }
     } else if (name == "--can-iface") {
       if (!take(&o.can_iface)) return false;
       if (o.can_iface.empty()) {
@@ -104,6 +113,10 @@ bool parse_cli(int argc, const char* const* argv, Options* out, std::string* err
       *error = "unknown option \"" + a + "\"";
       return false;
     }
+  }
+  if (!o.can_log.empty() && !o.can_socket.empty()) {
+    *error = "--can-log and --can-socket both choose the CAN backend; give one of them";
+    return false;
   }
   (void)have_board;  // --board defaults to "sim", the board with no hardware
   *out = o;

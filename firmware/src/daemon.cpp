@@ -23,6 +23,7 @@ class FrameRecorder {};  // --record is not built in; the member stays null
 #include "tacse3/hal/camera/v4l2_camera.hpp"
 #include "tacse3/hal/can/log_channel.hpp"
 #include "tacse3/hal/can/socketcan.hpp"
+#include "tacse3/hal/can/unix_channel.hpp"
 #include "tacse3/hal/gpio.hpp"
 #include "tacse3/hal/gpio/controller.hpp"
 #include "tacse3/sim/simulator.hpp"
@@ -239,7 +240,17 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
   ep.node_id = static_cast<std::uint8_t>(board.can.node_id);
   ep.layout.mode =
       board.can.extended_ids ? protocol::IdMode::kExtended : protocol::IdMode::kStandard;
-  if (!options.can_log.empty() || board.can.backend == config::CanBackend::kLog) {
+  if (!options.can_socket.empty()) {
+    std::string e;
+    auto ch = hal::can::UnixSocketChannel::listen(
+        options.can_socket, e, board.can.interface.empty() ? "can0" : board.can.interface);
+    if (!ch) {
+      *error = std::string("--can-socket: ") + e;
+      return nullptr;
+    }
+    d->unix_channel_ = ch.get();
+    d->channel_ = std::move(ch);
+  } else if (!options.can_log.empty() || board.can.backend == config::CanBackend::kLog) {
     const std::string out = !options.can_log.empty() ? options.can_log : board.can.log;
     std::string e;
     auto ch = hal::can::LogChannel::open(
@@ -496,8 +507,27 @@ void Daemon::check_can_log() {
   stop_.store(true, std::memory_order_release);
 }
 
+// Peers of --can-socket come and go (each tacse3-ctl call is one); bad input is said once.
+void Daemon::report_can_socket() {
+  if (unix_channel_ == nullptr) return;
+  const hal::can::UnixSocketChannel::Counters c = unix_channel_->counters();
+  if (c.accepted != socket_seen_.accepted || c.disconnected != socket_seen_.disconnected) {
+    say(2, "CAN socket %s: %u peer(s) connected", unix_channel_->path().c_str(), c.peers);
+  }
+  if (c.refused > 0 && socket_seen_.refused == 0) {
+    say(1, "CAN socket %s: connection refused: %zu peers already connected",
+        unix_channel_->path().c_str(), hal::can::UnixSocketChannel::kMaxPeers);
+  }
+  if (c.bad_lines > 0 && socket_seen_.bad_lines == 0) {
+    say(1, "CAN socket %s: ignoring input lines that are not candump -L (counted; first: \"%s\")",
+        unix_channel_->path().c_str(), unix_channel_->first_bad_line().c_str());
+  }
+  socket_seen_ = c;
+}
+
 void Daemon::housekeeping_tick(std::int64_t now_ns, bool handle_signals) {
   check_can_log();
+  report_can_socket();
 #if TACSE3_HAVE_RECORDER
   // A write error (disk full, directory gone) stops the recording, never the stream.
   if (recorder_ && !recording_failure_reported_ && recorder_->failed()) {
@@ -638,6 +668,13 @@ int Daemon::run(bool handle_signals) {
   }
 #endif
   check_can_log();  // frames sent during the shutdown
+  if (unix_channel_ != nullptr) {
+    const hal::can::UnixSocketChannel::Counters c = unix_channel_->counters();
+    if (c.bad_lines > 0)
+      say(1, "CAN socket: %llu bad input line(s) ignored (%llu longer than %zu characters)",
+          static_cast<unsigned long long>(c.bad_lines),
+          static_cast<unsigned long long>(c.long_lines), hal::can::UnixSocketChannel::kLineMax - 1);
+  }
   summary_.streaming_s =
       ready_sent_ ? static_cast<double>(stop_ns - streaming_since_ns_) * 1e-9 : 0.0;
   finish_summary();

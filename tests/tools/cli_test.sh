@@ -171,7 +171,7 @@ done
 check "sim --out '' exits 2" test $? -eq 2
 check "sim --out '' is named" contains "$T/e10" "--out: empty path"
 if [ -n "$TACSE3D" ]; then
-  for opt in --calibration --record --can-iface; do
+  for opt in --calibration --record --can-iface --can-socket; do
     "$TACSE3D" --board sim --check "$opt" '' > /dev/null 2> "$T/e20"
     check "tacse3d $opt '' exits 2" test $? -eq 2
     check "tacse3d $opt '' is named" contains "$T/e20" "tacse3d: $opt needs"
@@ -188,6 +188,19 @@ if [ -n "$TACSE3D" ]; then
   check "tacse3d names the CAN log and the cause" \
     contains "$T/e22" "CAN log /dev/full: write failed: No space left on device"
   check "the CAN log error is said once" test "$(grep -c 'write failed' "$T/e22")" -eq 1
+fi
+
+# --can-socket: one CAN backend at a time (usage, exit 2); a path that is a file is never replaced.
+if [ -n "$TACSE3D" ]; then
+  "$TACSE3D" --board sim --check --can-log - --can-socket "$T/can.sock" > /dev/null 2> "$T/e27"
+  check "tacse3d --can-log with --can-socket exits 2" test $? -eq 2
+  check "tacse3d names both backend options" contains "$T/e27" "--can-log and --can-socket"
+  echo keep > "$T/plain"
+  bounded "$TACSE3D" --board sim --seconds 1 --can-socket "$T/plain" > /dev/null 2> "$T/e28"
+  check "tacse3d --can-socket on a file exits 1" test $? -eq 1
+  check "tacse3d names the file it will not replace" \
+    contains "$T/e28" "$T/plain' exists and is not a socket"
+  check "the file is kept" test "$(cat "$T/plain")" = keep
 fi
 
 # --check refuses a [sim] object the simulator has no preset for, as the run would.

@@ -12,6 +12,7 @@
 
 #include "tacse3/hal/can/log_channel.hpp"
 #include "tacse3/hal/can/socketcan.hpp"
+#include "tacse3/hal/can/unix_channel.hpp"
 #include "tacse3/protocol/protocol.hpp"
 
 namespace {
@@ -74,17 +75,20 @@ int main(int argc, char** argv) {
       "Send a command to a tacse3 gripper and wait for its ACK.\n"
       "Examples:\n  tacse3-ctl --iface can0 --node 1 tare\n"
       "  tacse3-ctl --iface can0 --node 2 finger-separation 0.085\n"
+      "  tacse3-ctl --socket /tmp/tacse3-can.sock --node 1 reset-pose   (tacse3d --can-socket)\n"
       "  tacse3-ctl --log-out - --node 1 tare            (print the frame as candump -L)\n"
       "  tacse3-ctl --log-out cmd.log --ack-from replies.log --node 1 query stream\n"
       "Exit status: 0 ACK, 1 error, 2 usage, 3 NACK, 4 no ACK before the timeout.",
       "tacse3-ctl"};
-  std::string iface, log_out, ack_from, base = "0x1ACE0000";
+  std::string iface, socket_path, log_out, ack_from, base = "0x1ACE0000";
   unsigned node = 1;
   int timeout_ms = 250;
   int seq = -1;
   bool extended = false, fd = false, no_wait = false;
   auto* dst = app.add_option_group("destination");
   dst->add_option("--iface", iface, "SocketCAN interface, e.g. can0");
+  dst->add_option("--socket", socket_path,
+                  "Unix socket of a tacse3d started with --can-socket PATH (host without CAN)");
   dst->add_option("--log-out", log_out, "Write the command as a candump -L line (file or -)");
   dst->require_option(1);
   app.add_option("--ack-from", ack_from,
@@ -209,6 +213,13 @@ int main(int argc, char** argv) {
       return kExitError;
     }
     out = std::move(s);
+  } else if (!socket_path.empty()) {
+    auto s = can::UnixSocketChannel::connect(socket_path, error);
+    if (!s) {
+      std::cerr << "tacse3-ctl: " << error << '\n';
+      return kExitError;
+    }
+    out = std::move(s);
   } else {
     auto w = can::LogChannel::open("", log_out, error);
     if (!w) {
@@ -230,19 +241,29 @@ int main(int argc, char** argv) {
     return kExitError;
   }
   can::Channel& rx_channel = in ? *in : *out;
-  const bool can_wait = !iface.empty() || in != nullptr;
-  if (no_wait || !can_wait) {
+  const bool live = !iface.empty() || !socket_path.empty();  // else: logs, read to their end
+  if (no_wait || (!live && in == nullptr)) {
     std::cerr << "tacse3-ctl: sent " << name << " to node " << node << " (seq "
               << unsigned{cmd.sequence} << ")\n";
+    if (!no_wait) {
+      std::cerr << "tacse3-ctl: not waiting for the ACK: a log file carries no replies (talk to "
+                   "tacse3d --can-socket PATH with --socket PATH, or use --iface)\n";
+    }
     return kExitOk;
   }
 
   const std::int64_t deadline = monotonic_ms() + timeout_ms;
+  std::uint64_t replies_from_node = 0;  // any ACK/NACK of this node, for the message below
   for (;;) {
     const std::int64_t left = deadline - monotonic_ms();
-    if (!iface.empty() && left <= 0) break;  // a log is read to its end, no timeout
+    if (live && left <= 0) break;  // a log is read to its end, no timeout
     can::RxFrame rx;
     const can::RxResult r = rx_channel.receive(rx, static_cast<int>(left > 0 ? left : 0));
+    if (r == can::RxResult::kEnd && !socket_path.empty()) {
+      std::cerr << "tacse3-ctl: tacse3d closed the connection on " << socket_path
+                << " before answering " << name << " (stopped, or too many peers connected)\n";
+      return kExitError;
+    }
     if (r == can::RxResult::kTimeout || r == can::RxResult::kEnd) break;
     if (r == can::RxResult::kError) {
       std::cerr << "tacse3-ctl: " << rx_channel.last_error() << '\n';
@@ -251,10 +272,9 @@ int main(int argc, char** argv) {
     tp::Decoded d;
     if (tp::decode(rx.frame, tx.endpoint.layout, d) != tp::Status::kOk) continue;
     const auto* a = std::get_if<tp::Ack>(&d.payload);
-    if (a == nullptr || d.node_id != node || a->command != cmd.code ||
-        a->sequence != cmd.sequence) {
-      continue;
-    }
+    if (a == nullptr || d.node_id != node) continue;
+    ++replies_from_node;
+    if (a->command != cmd.code || a->sequence != cmd.sequence) continue;
     if (a->result == tp::AckCode::kAck) {
       std::cout << "node " << node << ": " << name << ' ' << describe_reply(*a) << " (seq "
                 << unsigned{cmd.sequence} << ")\n";
@@ -266,13 +286,23 @@ int main(int argc, char** argv) {
               << static_cast<unsigned>(a->result) << ", seq " << unsigned{cmd.sequence} << ")\n";
     return kExitNack;
   }
+  std::cerr << "tacse3-ctl: no ACK from node " << node << " for " << name << " (seq "
+            << unsigned{cmd.sequence} << ")";
   if (!iface.empty()) {
-    std::cerr << "tacse3-ctl: no ACK from node " << node << " for " << name << " (seq "
-              << unsigned{cmd.sequence} << ") within " << timeout_ms
+    std::cerr << " within " << timeout_ms
               << " ms: is the gripper powered, on this bus, with this node id and bit rate?\n";
+  } else if (!socket_path.empty()) {
+    std::cerr << " within " << timeout_ms << " ms on " << socket_path
+              << ": does that tacse3d use node id " << node << "?\n";
+  } else if (replies_from_node == 0) {
+    // The usual case: the log is what a tacse3d --can-log wrote, and that daemon never saw the
+    // command, because a log file only carries frames one way.
+    std::cerr << " in " << ack_from << ": it holds no ACK or NACK from node " << node
+              << " at all. A log carries no replies: the gripper must receive the command "
+                 "(tacse3d --can-log reads none). Talk to it live: tacse3d --can-socket PATH "
+                 "with tacse3-ctl --socket PATH, or --iface on a CAN or vcan bus\n";
   } else {
-    std::cerr << "tacse3-ctl: no ACK from node " << node << " for " << name << " (seq "
-              << unsigned{cmd.sequence} << ") in " << ack_from << '\n';
+    std::cerr << " in " << ack_from << '\n';
   }
   return kExitNoAck;
 }

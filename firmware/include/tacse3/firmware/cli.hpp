@@ -11,6 +11,7 @@ struct Options {
   std::string calibration;  // empty: built-in defaults
   std::string can_log;      // non-empty: log backend to this file, "-" = stdout
   std::string can_iface;    // non-empty: override [can].interface
+  std::string can_socket;   // non-empty: candump -L both ways on a Unix socket at this path
   double seconds = 0.0;     // 0 = until SIGTERM/SIGINT
   std::string record_dir;
   bool check = false;

@@ -14,6 +14,7 @@
 #include "tacse3/firmware/cli.hpp"
 #include "tacse3/firmware/engine.hpp"
 #include "tacse3/hal/can/channel.hpp"
+#include "tacse3/hal/can/unix_channel.hpp"
 
 namespace tacse3::hal {
 namespace can {
@@ -90,6 +91,7 @@ class Daemon {
   void rx_loop();
   void housekeeping_tick(std::int64_t now_ns, bool handle_signals);
   void check_can_log();
+  void report_can_socket();
   void finish_summary();
   void say(int level, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
 
@@ -105,7 +107,9 @@ class Daemon {
   // wait for ring space instead of dropping: nothing is lost when the loop is the slower side.
   std::array<bool, 2> backpressure_{};
   std::unique_ptr<hal::can::Channel> channel_;
-  hal::can::LogChannel* log_channel_ = nullptr;  // channel_, when it is the log backend
+  hal::can::LogChannel* log_channel_ = nullptr;          // channel_, when it is the log backend
+  hal::can::UnixSocketChannel* unix_channel_ = nullptr;  // channel_, with --can-socket
+  hal::can::UnixSocketChannel::Counters socket_seen_;    // as last reported
   int exit_code_ = 0;
   std::unique_ptr<hal::GpioBackend> gpio_;
   std::unique_ptr<hal::GpioController> gpio_controller_;
