@@ -1,0 +1,230 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3-truth: truth.csv for a recording from robot pose logs (docs/truth.md).
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tacse3/fileio/file_io.hpp"
+#include "tacse3/tools/cli.hpp"
+#include "tacse3/tools/progress.hpp"
+#include "tacse3/tools/replay.hpp"
+#include "tacse3/tools/source.hpp"
+#include "tacse3/tools/truth/clock_sync.hpp"
+#include "tacse3/tools/truth/truth.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace tt = tacse3::tools;
+namespace tr = tacse3::tools::truth;
+
+int fail(const std::string& msg) {
+  std::fprintf(stderr, "tacse3-truth: error: %s\n", msg.c_str());
+  return 1;
+}
+
+int usage(const std::string& msg) {
+  std::fprintf(stderr, "tacse3-truth: %s\nRun with --help for more information.\n", msg.c_str());
+  return 2;
+}
+
+// The relative orientation object-in-gripper at the gripper log's times inside the object log:
+// what --clock-offset auto correlates when both move.
+tr::PoseLog relative_log(const tr::PoseLog& gripper, const tr::PoseLog& object) {
+  tr::PoseLog rel;
+  rel.name = gripper.name + " and " + object.name;
+  for (std::size_t i = 0; i < gripper.size(); ++i) {
+    const std::int64_t t = gripper.t_ns[i];
+    if (!object.covers(t, t)) continue;
+    rel.t_ns.push_back(t);
+    rel.pose.push_back(tr::inverse(gripper.pose[i]) * object.at(t));
+  }
+  return rel;
+}
+
+// The pipeline's orientation per frame (default calibration: only the shape is used).
+std::string pipeline_orientations(tt::RecordingSource& source, bool progress,
+                                  std::vector<Eigen::Quaterniond>* q) {
+  tt::ProgressBar bar("tacse3-truth: replay",
+                      static_cast<std::int64_t>(source.info().frame_count()), progress);
+  tt::ReplaySinks sinks;
+  sinks.progress = &bar;
+  const tt::ReplayRun run = tt::run_replay(source, tt::ReplayOptions{}, sinks);
+  bar.finish();
+  if (!run.error.empty()) return run.error;
+  q->clear();
+  for (const auto& f : run.frames) q->push_back(f.pose.q);
+  return {};
+}
+
+struct Options {
+  std::string rec_dir, gripper_log, object_log, tcp_to_grasp, gripper_pose, clock_offset;
+  std::string can_log, out;
+  bool force = false, quiet = false;
+};
+
+// The clock offset by the method the options name; *how says which and how well it fits.
+std::string sync_clock(const Options& o, tt::RecordingSource& source, const tr::PoseLog& log,
+                       std::int64_t* offset_ns, std::string* how) {
+  const std::vector<std::int64_t>& t = source.info().t_ns;
+  char buf[512];
+  if (!o.can_log.empty()) {
+    tr::CanSync s;
+    if (std::string e = tr::read_can_sync(o.can_log, t.front(), t.back(), &s); !e.empty()) return e;
+    *offset_ns = s.offset_ns;
+    std::snprintf(buf, sizeof(buf),
+                  "from the CAN log %s: %zu cycles, arrival - SampleTime spread %.3f ms (robust "
+                  "sigma), latency %.3f ms subtracted (%s)",
+                  o.can_log.c_str(), s.cycles, s.spread_s * 1e3, s.latency_s * 1e3,
+                  s.latency_reports > 0 ? "median LatencyP50 of the StatusTiming frames"
+                                        : "none reported: assumed 0");
+    *how = buf;
+    return {};
+  }
+  if (o.clock_offset == "auto") {
+    std::vector<Eigen::Quaterniond> q;
+    if (std::string e = pipeline_orientations(source, !o.quiet && tt::stderr_is_tty(), &q);
+        !e.empty()) {
+      return e;
+    }
+    tr::AutoSync a;
+    if (std::string e = tr::sync_by_correlation(t, q, log, &a); !e.empty()) return e;
+    *offset_ns = a.offset_ns;
+    std::snprintf(buf, sizeof(buf),
+                  "auto: angular-speed correlation %.3f (next best peak %.3f at %.6f s), motion "
+                  "%.0f times the speed noise",
+                  a.correlation, a.runner_up, static_cast<double>(a.runner_up_ns) * 1e-9,
+                  a.motion_snr);
+    *how = buf;
+    return {};
+  }
+  *offset_ns = std::llround(std::stod(o.clock_offset) * 1e9);
+  *how = "given (--clock-offset)";
+  return {};
+}
+
+int execute(const Options& o) {
+  if (o.gripper_log.empty() && o.object_log.empty()) {
+    return usage(
+        "give --gripper-log FILE (the gripper moves) or --object-log FILE (the object "
+        "moves), or both");
+  }
+  if (!o.can_log.empty() && !o.clock_offset.empty()) {
+    return usage("--can-log and --clock-offset both set the clock offset; give one");
+  }
+  if (o.can_log.empty() && o.clock_offset.empty()) {
+    return usage(
+        "no clock sync: give --clock-offset SECONDS (0 when the robot log has the "
+        "recording's clock), --clock-offset auto, or --can-log FILE");
+  }
+  if (o.clock_offset != "auto" && !o.clock_offset.empty()) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(o.clock_offset, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != o.clock_offset.size() || !std::isfinite(v) || std::abs(v) > 9e9) {
+      return usage("--clock-offset: expected seconds or auto, got \"" + o.clock_offset + "\"");
+    }
+  }
+  tr::Rig rig;
+  if (!o.tcp_to_grasp.empty()) {
+    if (std::string e = tr::parse_pose_text(o.tcp_to_grasp, &rig.tcp_to_grasp); !e.empty()) {
+      return usage("--tcp-to-grasp: " + e);
+    }
+  }
+  if (!o.gripper_pose.empty()) {
+    if (!o.gripper_log.empty())
+      return usage("--gripper-pose is for a fixed gripper: drop it or --gripper-log");
+    if (std::string e = tr::parse_pose_text(o.gripper_pose, &rig.fixed_tcp); !e.empty()) {
+      return usage("--gripper-pose: " + e);
+    }
+  }
+  const fs::path out = o.out.empty() ? fs::path(o.rec_dir) / "truth.csv" : fs::path(o.out);
+  std::string err;
+  if (fs::exists(fs::symlink_status(out)) && !o.force) {
+    return fail(out.string() + ": exists; give --force to replace it");
+  }
+  if (!tacse3::fileio::check_output_file(out, &err)) return fail(err);
+
+  auto source = tt::RecordingSource::open(o.rec_dir, &err);
+  if (!source) return fail(err);
+  tr::PoseLog gripper, object;
+  if (!o.gripper_log.empty()) {
+    if (err = tr::read_pose_log(o.gripper_log, &gripper); !err.empty()) return fail(err);
+    rig.gripper = &gripper;
+  }
+  if (!o.object_log.empty()) {
+    if (err = tr::read_pose_log(o.object_log, &object); !err.empty()) return fail(err);
+    rig.object = &object;
+  }
+  const tr::PoseLog sync_log = rig.gripper != nullptr && rig.object != nullptr
+                                   ? relative_log(gripper, object)
+                                   : (rig.gripper != nullptr ? gripper : object);
+  std::int64_t offset_ns = 0;
+  std::string how;
+  if (err = sync_clock(o, *source, sync_log, &offset_ns, &how); !err.empty()) return fail(err);
+  std::vector<tacse3::recording::TruthSample> rows;
+  if (err = tr::make_truth(rig, source->info().t_ns, offset_ns, &rows); !err.empty()) {
+    return fail(err);
+  }
+  if (!tacse3::fileio::write_file_atomically(out, tr::truth_csv(rows), &err)) return fail(err);
+  if (o.quiet) return 0;
+  double max_deg = 0.0, max_mm = 0.0;
+  for (const auto& r : rows) {
+    max_deg = std::max(
+        max_deg, tr::rotation_angle(Eigen::Quaterniond(r.qw, r.qx, r.qy, r.qz)) * 180.0 / M_PI);
+    max_mm = std::max(max_mm, Eigen::Vector3d(r.px, r.py, r.pz).norm() * 1e3);
+  }
+  std::printf("tacse3-truth: clock offset %.6f s, %s\n", static_cast<double>(offset_ns) * 1e-9,
+              how.c_str());
+  std::printf(
+      "tacse3-truth: wrote %s: %zu rows, object rotation up to %.2f deg, translation up "
+      "to %.2f mm\n",
+      out.c_str(), rows.size(), max_deg, max_mm);
+  return 0;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{
+      "Writes truth.csv for a tacse3 recording from robot pose logs: the object's pose in the "
+      "grasp frame G relative to the first frame (docs/truth.md)."};
+  Options o;
+  const CLI::Validator path = tt::non_empty_path();
+  app.add_option("--recording", o.rec_dir, "recording directory (docs/recording-format.md)")
+      ->required()
+      ->check(path);
+  app.add_option("--gripper-log", o.gripper_log,
+                 "CSV: the robot TCP's pose in a fixed world frame over time (object fixed)")
+      ->check(path);
+  app.add_option("--object-log", o.object_log,
+                 "CSV: the object's pose in the world over time (gripper fixed)")
+      ->check(path);
+  app.add_option("--tcp-to-grasp", o.tcp_to_grasp,
+                 "\"x y z qw qx qy qz\": the grasp frame G in the TCP frame (default identity)");
+  app.add_option("--gripper-pose", o.gripper_pose,
+                 "\"x y z qw qx qy qz\": the fixed TCP pose in the world when there is no "
+                 "--gripper-log (default identity)");
+  app.add_option("--clock-offset", o.clock_offset,
+                 "SECONDS (robot-log time = recording time + SECONDS) or auto (cross-correlate "
+                 "the angular speeds)");
+  app.add_option("--can-log", o.can_log,
+                 "candump -L log taken on the robot's clock during the recording: clock sync")
+      ->check(path);
+  app.add_option("--out", o.out, "output file (default REC_DIR/truth.csv)")->check(path);
+  app.add_flag("--force", o.force, "replace an existing output file");
+  app.add_flag("-q,--quiet", o.quiet, "no progress bar and no summary");
+  if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  return execute(o);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return tt::finish_stdout("tacse3-truth", run(argc, argv));
+}

@@ -1,0 +1,314 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3-truth: clock offset from a controller-side candump log, or by cross-correlating the
+// angular speed of the recording's pipeline estimate with the robot log's.
+#include "tacse3/tools/truth/clock_sync.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <variant>
+
+#include "tacse3/fileio/file_io.hpp"
+#include "tacse3/protocol/protocol.hpp"
+
+namespace tacse3::tools::truth {
+
+namespace proto = tacse3::protocol;
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const std::size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m), v.end());
+  const double hi = v[m];
+  if (v.size() % 2 == 1) return hi;
+  return 0.5 * (hi + *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(m)));
+}
+
+double robust_sigma(const std::vector<double>& v) {
+  const double m = median(v);
+  std::vector<double> d(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) d[i] = std::abs(v[i] - m);
+  return 1.4826 * median(std::move(d));
+}
+
+std::string read_text(const std::filesystem::path& file, std::size_t limit, std::string* text) {
+  const fileio::ReadResult r = fileio::read_regular_file(file, limit, text);
+  if (r.ok()) return {};
+  switch (r.error) {
+    case fileio::ReadError::kNotFound:
+      return file.string() + ": no such file";
+    case fileio::ReadError::kNotRegular:
+      return file.string() + ": is " + r.kind + ", not a regular file";
+    case fileio::ReadError::kTooLarge:
+      return file.string() + ": larger than " + fileio::size_text(limit);
+    default:
+      return file.string() + ": cannot read" + fileio::os_error(r.os_errno);
+  }
+}
+
+}  // namespace
+
+std::string sync_by_can_log(std::string_view text, const std::string& name, std::int64_t first_ns,
+                            std::int64_t last_ns, CanSync* out) {
+  proto::CycleReassembler cycles;
+  const proto::IdLayout layout{};
+  std::vector<double> lag_s, latency_s;  // arrival - sample; reported latency p50
+  std::size_t line_no = 0, outside = 0;
+  while (!text.empty()) {
+    const std::size_t nl = text.find('\n');
+    std::string_view line = text.substr(0, nl);
+    text.remove_prefix(nl == std::string_view::npos ? text.size() : nl + 1);
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty()) continue;
+    proto::LogRecord rec;
+    if (proto::parse_candump_line(line, rec) != proto::Status::kOk) {
+      return name + " line " + std::to_string(line_no) +
+             ": not a candump -L line (\"(seconds.micros) iface id#data\")";
+    }
+    if (rec.error_frame || rec.rtr) continue;
+    proto::Decoded d;
+    if (proto::decode(rec.frame, layout, d) != proto::Status::kOk) continue;
+    if (const auto* timing = std::get_if<proto::TimingMsg>(&d.payload);
+        timing != nullptr && d.node_id == cycles.endpoint().node_id &&
+        std::isfinite(timing->latency_p50_s)) {
+      latency_s.push_back(timing->latency_p50_s);
+    }
+    proto::Cycle c;
+    if (cycles.feed(d, c) != proto::CycleReassembler::Result::kComplete) continue;
+    const std::int64_t sample_ns = static_cast<std::int64_t>(c.timestamp_us) * 1000;
+    if (sample_ns < first_ns - 1000 || sample_ns > last_ns) {
+      ++outside;
+      continue;
+    }
+    lag_s.push_back((static_cast<double>(rec.time_us) - static_cast<double>(c.timestamp_us)) *
+                    1e-6);
+  }
+  if (lag_s.empty()) {
+    return name + ": no complete tacse3 cycle (node 1, 11-bit identifiers) whose SampleTime " +
+           "falls within the recording (" + std::to_string(outside) +
+           " outside it): is this the controller's candump -L log of this recording?";
+  }
+  CanSync s;
+  s.cycles = lag_s.size();
+  s.latency_reports = latency_s.size();
+  s.latency_s = median(latency_s);
+  s.spread_s = robust_sigma(lag_s);
+  // Subtracting in µs keeps the precision of epoch stamps (1.7e9 s).
+  s.offset_ns = std::llround((median(lag_s) - s.latency_s) * 1e9);
+  *out = s;
+  return {};
+}
+
+std::string read_can_sync(const std::filesystem::path& file, std::int64_t first_ns,
+                          std::int64_t last_ns, CanSync* out) {
+  std::string text;
+  if (std::string e = read_text(file, kMaxCanLogBytes, &text); !e.empty()) return e;
+  return sync_by_can_log(text, file.string(), first_ns, last_ns, out);
+}
+
+std::vector<double> angular_speed(const std::vector<std::int64_t>& t_ns,
+                                  const std::vector<Eigen::Quaterniond>& q) {
+  const std::size_t n = t_ns.size();
+  std::vector<double> s(n, 0.0);
+  if (n < 2) return s;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t lo = i > 0 ? i - 1 : 0, hi = i + 1 < n ? i + 1 : n - 1;
+    s[i] = rotation_angle(q[lo].conjugate() * q[hi]) /
+           (static_cast<double>(t_ns[hi] - t_ns[lo]) * 1e-9);
+  }
+  return s;
+}
+
+double difference_noise(const std::vector<double>& s) {
+  if (s.size() < 3) return 0.0;
+  std::vector<double> d(s.size() - 1);
+  for (std::size_t i = 0; i + 1 < s.size(); ++i) d[i] = s[i + 1] - s[i];
+  return robust_sigma(d) / std::sqrt(2.0);
+}
+
+namespace {
+
+// Pearson correlation of a and b (0 when either is constant).
+double pearson(const std::vector<double>& a, const std::vector<double>& b) {
+  const double n = static_cast<double>(a.size());
+  const double ma = std::accumulate(a.begin(), a.end(), 0.0) / n;
+  const double mb = std::accumulate(b.begin(), b.end(), 0.0) / n;
+  double sab = 0.0, saa = 0.0, sbb = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    sab += (a[i] - ma) * (b[i] - mb);
+    saa += (a[i] - ma) * (a[i] - ma);
+    sbb += (b[i] - mb) * (b[i] - mb);
+  }
+  return saa > 0.0 && sbb > 0.0 ? sab / std::sqrt(saa * sbb) : 0.0;
+}
+
+// The log's angular speed with the recording's difference operator, read at t + offset.
+std::vector<double> log_speed(const std::vector<std::int64_t>& t_ns, const PoseLog& log,
+                              double offset_ns) {
+  const std::size_t n = t_ns.size();
+  std::vector<double> s(n, 0.0);
+  const std::int64_t off = std::llround(offset_ns);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t lo = i > 0 ? i - 1 : 0, hi = i + 1 < n ? i + 1 : n - 1;
+    const Eigen::Quaterniond a = log.at(t_ns[lo] + off).q, b = log.at(t_ns[hi] + off).q;
+    s[i] = rotation_angle(a.conjugate() * b) / (static_cast<double>(t_ns[hi] - t_ns[lo]) * 1e-9);
+  }
+  return s;
+}
+
+// Linear interpolation of the series (t, v) at time x (clamped at the ends).
+double sample(const std::vector<std::int64_t>& t, const std::vector<double>& v, double x) {
+  if (x <= static_cast<double>(t.front())) return v.front();
+  if (x >= static_cast<double>(t.back())) return v.back();
+  const auto it = std::upper_bound(
+      t.begin(), t.end(), x, [](double a, std::int64_t b) { return a < static_cast<double>(b); });
+  const std::size_t b = static_cast<std::size_t>(it - t.begin()), a = b - 1;
+  const double u = (x - static_cast<double>(t[a])) / static_cast<double>(t[b] - t[a]);
+  return (1.0 - u) * v[a] + u * v[b];
+}
+
+double range(const std::vector<double>& v) {
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  return *hi - *lo;
+}
+
+double snr(const std::vector<double>& v) {
+  const double noise = difference_noise(v), r = range(v);
+  if (noise > 0.0) return r / noise;
+  return r > 0.0 ? 1e9 : 0.0;
+}
+
+// Correlation of r (uniform grid) with every window of g (same grid) at integer lags.
+std::vector<double> grid_correlation(const std::vector<double>& r, const std::vector<double>& g) {
+  const std::size_t n = r.size(), lags = g.size() - n + 1;
+  const double dn = static_cast<double>(n);
+  const double mr = std::accumulate(r.begin(), r.end(), 0.0) / dn;
+  std::vector<double> rc(n);
+  double srr = 0.0;
+  for (std::size_t i = 0; i < n; ++i) srr += (rc[i] = r[i] - mr) * rc[i];
+  std::vector<double> s1(g.size() + 1, 0.0), s2(g.size() + 1, 0.0);
+  for (std::size_t j = 0; j < g.size(); ++j) {
+    s1[j + 1] = s1[j] + g[j];
+    s2[j + 1] = s2[j] + g[j] * g[j];
+  }
+  std::vector<double> c(lags, 0.0);
+  for (std::size_t k = 0; k < lags; ++k) {
+    double sab = 0.0;  // sum rc_i g_{i+k} = sum rc_i (g_{i+k} - mean), since sum rc_i = 0
+    for (std::size_t i = 0; i < n; ++i) sab += rc[i] * g[i + k];
+    const double sum = s1[k + n] - s1[k];
+    const double sgg = (s2[k + n] - s2[k]) - sum * sum / dn;
+    c[k] = srr > 0.0 && sgg > 1e-12 * dn ? sab / std::sqrt(srr * sgg) : 0.0;
+  }
+  return c;
+}
+
+}  // namespace
+
+std::string sync_by_correlation(const std::vector<std::int64_t>& t_ns,
+                                const std::vector<Eigen::Quaterniond>& q, const PoseLog& log,
+                                AutoSync* out) {
+  const std::size_t n = t_ns.size();
+  if (n < 8) return "--clock-offset auto: the recording has too few frames to correlate";
+  std::vector<std::int64_t> dt(n - 1);
+  for (std::size_t i = 0; i + 1 < n; ++i) dt[i] = t_ns[i + 1] - t_ns[i];
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  const std::int64_t step = dt[dt.size() / 2];  // the frame period: the coarse grid's step
+  const std::int64_t span = t_ns.back() - t_ns.front();
+  const std::int64_t log_span = log.t_ns.back() - log.t_ns.front();
+  if (log_span < span + 2 * step) {
+    return log.name + ": spans " + std::to_string(static_cast<double>(log_span) * 1e-9) +
+           " s, shorter than the recording (" + std::to_string(static_cast<double>(span) * 1e-9) +
+           " s): it cannot cover it at any clock offset";
+  }
+  // Both speeds on the grid of one frame period: the recording's from t_ns[0], the log's from
+  // its first sample + one step.
+  const std::vector<double> rec_speed = angular_speed(t_ns, q);
+  const std::size_t nr = static_cast<std::size_t>(span / step) + 1;
+  std::vector<double> r(nr);
+  for (std::size_t i = 0; i < nr; ++i) {
+    r[i] = sample(
+        t_ns, rec_speed,
+        static_cast<double>(t_ns.front()) + static_cast<double>(i) * static_cast<double>(step));
+  }
+  const std::size_t ng = static_cast<std::size_t>((log_span - 2 * step) / step) + 1;
+  std::vector<double> g(ng);
+  for (std::size_t j = 0; j < ng; ++j) {
+    const std::int64_t tau = log.t_ns.front() + step + static_cast<std::int64_t>(j) * step;
+    g[j] = rotation_angle(log.at(tau - step).q.conjugate() * log.at(tau + step).q) /
+           (2e-9 * static_cast<double>(step));
+  }
+  char buf[320];
+  if (const double s = snr(r); s < kMinMotionSnr) {
+    std::snprintf(buf, sizeof(buf),
+                  "--clock-offset auto: too little rotation in the recording to sync on (the "
+                  "pipeline's angular speed spans %.1f times its noise, at least %.0f needed); "
+                  "give --can-log or --clock-offset SECONDS",
+                  s, kMinMotionSnr);
+    return buf;
+  }
+  if (const double s = snr(g); s < kMinMotionSnr) {
+    std::snprintf(buf, sizeof(buf),
+                  ": too little rotation to sync on (its angular speed spans %.1f times its "
+                  "noise, at least %.0f needed); give --can-log or --clock-offset SECONDS",
+                  s, kMinMotionSnr);
+    return log.name + buf;
+  }
+  const std::vector<double> c = grid_correlation(r, g);
+  const std::size_t best =
+      static_cast<std::size_t>(std::max_element(c.begin(), c.end()) - c.begin());
+  // The main lobe: the lags around the best where the correlation stays above half of it.
+  std::size_t lo = best, hi = best;
+  while (lo > 0 && c[lo - 1] >= 0.5 * c[best]) --lo;
+  while (hi + 1 < c.size() && c[hi + 1] >= 0.5 * c[best]) ++hi;
+  AutoSync a;
+  a.runner_up = -1.0;
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    if ((k < lo || k > hi) && c[k] > a.runner_up) {
+      a.runner_up = c[k];
+      a.runner_up_ns = log.t_ns.front() + step + static_cast<std::int64_t>(k) * step - t_ns.front();
+    }
+  }
+  // Golden-section search of the exact correlation within one period of the best grid lag.
+  const double grid_offset = static_cast<double>(log.t_ns.front() + step - t_ns.front()) +
+                             static_cast<double>(best) * static_cast<double>(step);
+  auto f = [&](double off) { return pearson(rec_speed, log_speed(t_ns, log, off)); };
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x0 = grid_offset - static_cast<double>(step), x3 = grid_offset + static_cast<double>(step);
+  double x1 = x3 - phi * (x3 - x0), x2 = x0 + phi * (x3 - x0);
+  double f1 = f(x1), f2 = f(x2);
+  while (x3 - x0 > 1e3) {  // 1 µs
+    if (f1 > f2) {
+      x3 = x2, x2 = x1, f2 = f1;
+      x1 = x3 - phi * (x3 - x0), f1 = f(x1);
+    } else {
+      x0 = x1, x1 = x2, f1 = f2;
+      x2 = x0 + phi * (x3 - x0), f2 = f(x2);
+    }
+  }
+  a.offset_ns = std::llround(0.5 * (x0 + x3));
+  a.correlation = f(static_cast<double>(a.offset_ns));
+  a.motion_snr = std::min(snr(r), snr(g));
+  if (a.correlation < kMinCorrelation) {
+    std::snprintf(buf, sizeof(buf),
+                  ": --clock-offset auto: the best correlation of the angular speeds is %.2f "
+                  "(at least %.2f needed): does this log belong to the recording?",
+                  a.correlation, kMinCorrelation);
+    return log.name + buf;
+  }
+  if (a.runner_up > kMaxRunnerUpRatio * a.correlation) {
+    std::snprintf(buf, sizeof(buf),
+                  ": --clock-offset auto is ambiguous: correlation %.3f at %.6f s and %.3f at "
+                  "%.6f s (a repeated motion?); give --can-log or --clock-offset SECONDS",
+                  a.correlation, static_cast<double>(a.offset_ns) * 1e-9, a.runner_up,
+                  static_cast<double>(a.runner_up_ns) * 1e-9);
+    return log.name + buf;
+  }
+  *out = a;
+  return {};
+}
+
+}  // namespace tacse3::tools::truth
