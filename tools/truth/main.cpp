@@ -45,19 +45,23 @@ tr::PoseLog relative_log(const tr::PoseLog& gripper, const tr::PoseLog& object) 
   return rel;
 }
 
-// The pipeline's orientation per frame (default calibration: only the shape is used).
-std::string pipeline_orientations(tt::RecordingSource& source, bool progress,
-                                  std::vector<Eigen::Quaterniond>* q) {
+// The pipeline's angular speed per frame interval: |omega| of each frame's fused twist before
+// the moving average (which would delay it by half its length), from the velocity proxy, which
+// measures the motion between consecutive frames. Default calibration: only the shape is used.
+std::string pipeline_speed(tt::RecordingSource& source, bool progress, std::vector<double>* speed) {
   tt::ProgressBar bar("tacse3-truth: replay",
                       static_cast<std::int64_t>(source.info().frame_count()), progress);
   tt::ReplaySinks sinks;
   sinks.progress = &bar;
-  const tt::ReplayRun run = tt::run_replay(source, tt::ReplayOptions{}, sinks);
+  speed->clear();
+  sinks.on_frame = [speed](std::size_t, const tt::FrameResult&, const tt::Replayer& engine) {
+    speed->push_back(engine.result().fused.xi.head<3>().norm());
+  };
+  tt::ReplayOptions options;
+  options.mode = tt::ProxyMode::kAuto;
+  const tt::ReplayRun run = tt::run_replay(source, options, sinks);
   bar.finish();
-  if (!run.error.empty()) return run.error;
-  q->clear();
-  for (const auto& f : run.frames) q->push_back(f.pose.q);
-  return {};
+  return run.error;
 }
 
 struct Options {
@@ -85,13 +89,13 @@ std::string sync_clock(const Options& o, tt::RecordingSource& source, const tr::
     return {};
   }
   if (o.clock_offset == "auto") {
-    std::vector<Eigen::Quaterniond> q;
-    if (std::string e = pipeline_orientations(source, !o.quiet && tt::stderr_is_tty(), &q);
+    std::vector<double> speed;
+    if (std::string e = pipeline_speed(source, !o.quiet && tt::stderr_is_tty(), &speed);
         !e.empty()) {
       return e;
     }
     tr::AutoSync a;
-    if (std::string e = tr::sync_by_correlation(t, q, log, &a); !e.empty()) return e;
+    if (std::string e = tr::sync_by_correlation(t, speed, log, &a); !e.empty()) return e;
     *offset_ns = a.offset_ns;
     std::snprintf(buf, sizeof(buf),
                   "auto: angular-speed correlation %.3f (next best peak %.3f at %.6f s), motion "

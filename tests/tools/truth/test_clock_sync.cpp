@@ -60,7 +60,7 @@ std::string can_log(std::int64_t offset_us, std::int64_t latency_us, double repo
 }
 
 TEST(CanSync, OffsetIsTheMedianArrivalLagLessTheReportedLatency) {
-  // Arrival of the completing (fifth) frame = sample + offset + 4500 µs + 4 * 130 µs +- 100 µs.
+  // Arrival of the Timestamp (first) frame = sample + offset + 4500 µs +- 100 µs.
   const std::string text = can_log(7'250'000, 4500, 4500.0, 121);
   tr::CanSync s;
   ASSERT_EQ(tr::sync_by_can_log(text, "c.log", 1'000'000'000, 1'995'000'000, &s), "");
@@ -68,7 +68,7 @@ TEST(CanSync, OffsetIsTheMedianArrivalLagLessTheReportedLatency) {
   EXPECT_EQ(s.latency_reports, 11u);
   EXPECT_NEAR(s.latency_s, 4.5e-3, 1e-9);
   // 60 lags at +100 µs and 60 at -100 µs: the median is their mean.
-  EXPECT_EQ(s.offset_ns, (7'250'000 + 4 * 130) * std::int64_t{1000});
+  EXPECT_EQ(s.offset_ns, (7'250'000) * std::int64_t{1000});
   EXPECT_NEAR(s.spread_s, 1.4826 * 100e-6, 1e-9);
 }
 
@@ -77,7 +77,7 @@ TEST(CanSync, WithoutALatencyReportTheLatencyIsTakenAsZero) {
   ASSERT_EQ(tr::sync_by_can_log(can_log(-900'000, 4500, -1.0, 120), "c.log", 0, 3'000'000'000, &s),
             "");
   EXPECT_EQ(s.latency_reports, 0u);
-  EXPECT_EQ(s.offset_ns, (-900'000 + 4500 + 4 * 130) * std::int64_t{1000});
+  EXPECT_EQ(s.offset_ns, (-900'000 + 4500) * std::int64_t{1000});
 }
 
 TEST(CanSync, ALogOfAnotherRecordingOrGarbageIsRefused) {
@@ -138,7 +138,7 @@ TEST(AutoSync, RecoversAnOffsetBetweenGridPoints) {
   for (const std::int64_t offset : {std::int64_t{3'141'592'653}, std::int64_t{-1'234'567}}) {
     const Signals s = signals(offset, 0.0);
     tr::AutoSync a;
-    ASSERT_EQ(tr::sync_by_correlation(s.t, s.q, s.log, &a), "");
+    ASSERT_EQ(tr::sync_by_correlation(s.t, tr::interval_speed(s.t, s.q), s.log, &a), "");
     EXPECT_NEAR(static_cast<double>(a.offset_ns - offset) * 1e-9, 0.0, 0.3e-3) << offset;
     EXPECT_GT(a.correlation, 0.99);
     EXPECT_LT(a.runner_up, 0.9 * a.correlation);
@@ -148,14 +148,14 @@ TEST(AutoSync, RecoversAnOffsetBetweenGridPoints) {
 TEST(AutoSync, NoiseOfARealArmCostsLessThanAMillisecond) {
   const Signals s = signals(5'500'000'000, 0.01);
   tr::AutoSync a;
-  ASSERT_EQ(tr::sync_by_correlation(s.t, s.q, s.log, &a), "");
+  ASSERT_EQ(tr::sync_by_correlation(s.t, tr::interval_speed(s.t, s.q), s.log, &a), "");
   EXPECT_NEAR(static_cast<double>(a.offset_ns - 5'500'000'000) * 1e-9, 0.0, 1e-3);
 }
 
 TEST(AutoSync, TooLittleMotionIsRefused) {
   const Signals s = signals(2'000'000'000, 0.01, 1e-5);
   tr::AutoSync a;
-  const std::string e = tr::sync_by_correlation(s.t, s.q, s.log, &a);
+  const std::string e = tr::sync_by_correlation(s.t, tr::interval_speed(s.t, s.q), s.log, &a);
   EXPECT_NE(e.find("too little rotation"), std::string::npos) << e;
 }
 
@@ -164,7 +164,7 @@ TEST(AutoSync, ARepeatingMotionIsAmbiguous) {
     return 0.2 * std::sin(2 * kPi * t / 0.7) + 0.05 * std::sin(2 * kPi * t / 0.35);
   });
   tr::AutoSync a;
-  const std::string e = tr::sync_by_correlation(s.t, s.q, s.log, &a);
+  const std::string e = tr::sync_by_correlation(s.t, tr::interval_speed(s.t, s.q), s.log, &a);
   EXPECT_NE(e.find("ambiguous"), std::string::npos) << e;
 }
 
@@ -173,7 +173,7 @@ TEST(AutoSync, ALogShorterThanTheRecordingIsRefused) {
   s.log.t_ns.resize(100);
   s.log.pose.resize(100);
   tr::AutoSync a;
-  const std::string e = tr::sync_by_correlation(s.t, s.q, s.log, &a);
+  const std::string e = tr::sync_by_correlation(s.t, tr::interval_speed(s.t, s.q), s.log, &a);
   EXPECT_NE(e.find("cannot cover it at any clock offset"), std::string::npos) << e;
 }
 

@@ -4,6 +4,7 @@
 #include "tacse3/tools/truth/clock_sync.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -56,6 +57,8 @@ std::string sync_by_can_log(std::string_view text, const std::string& name, std:
   proto::CycleReassembler cycles;
   const proto::IdLayout layout{};
   std::vector<double> lag_s, latency_s;  // arrival - sample; reported latency p50
+  // Arrival of each counter value's Timestamp frame: the cycle's first frame on the bus.
+  std::array<std::uint64_t, 16> stamp_arrival_us{};
   std::size_t line_no = 0, outside = 0;
   while (!text.empty()) {
     const std::size_t nl = text.find('\n');
@@ -77,6 +80,10 @@ std::string sync_by_can_log(std::string_view text, const std::string& name, std:
         std::isfinite(timing->latency_p50_s)) {
       latency_s.push_back(timing->latency_p50_s);
     }
+    if (std::holds_alternative<proto::TimestampMsg>(d.payload) &&
+        d.node_id == cycles.endpoint().node_id) {
+      stamp_arrival_us[std::get<proto::TimestampMsg>(d.payload).counter & 0x0F] = rec.time_us;
+    }
     proto::Cycle c;
     if (cycles.feed(d, c) != proto::CycleReassembler::Result::kComplete) continue;
     const std::int64_t sample_ns = static_cast<std::int64_t>(c.timestamp_us) * 1000;
@@ -84,8 +91,8 @@ std::string sync_by_can_log(std::string_view text, const std::string& name, std:
       ++outside;
       continue;
     }
-    lag_s.push_back((static_cast<double>(rec.time_us) - static_cast<double>(c.timestamp_us)) *
-                    1e-6);
+    const std::uint64_t arrival_us = stamp_arrival_us[c.counter & 0x0F];
+    lag_s.push_back((static_cast<double>(arrival_us) - static_cast<double>(c.timestamp_us)) * 1e-6);
   }
   if (lag_s.empty()) {
     return name + ": no complete tacse3 cycle (node 1, 11-bit identifiers) whose SampleTime " +
@@ -110,15 +117,12 @@ std::string read_can_sync(const std::filesystem::path& file, std::int64_t first_
   return sync_by_can_log(text, file.string(), first_ns, last_ns, out);
 }
 
-std::vector<double> angular_speed(const std::vector<std::int64_t>& t_ns,
-                                  const std::vector<Eigen::Quaterniond>& q) {
-  const std::size_t n = t_ns.size();
-  std::vector<double> s(n, 0.0);
-  if (n < 2) return s;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t lo = i > 0 ? i - 1 : 0, hi = i + 1 < n ? i + 1 : n - 1;
-    s[i] = rotation_angle(q[lo].conjugate() * q[hi]) /
-           (static_cast<double>(t_ns[hi] - t_ns[lo]) * 1e-9);
+std::vector<double> interval_speed(const std::vector<std::int64_t>& t_ns,
+                                   const std::vector<Eigen::Quaterniond>& q) {
+  std::vector<double> s(t_ns.size(), 0.0);
+  for (std::size_t i = 1; i < t_ns.size(); ++i) {
+    s[i] = rotation_angle(q[i - 1].conjugate() * q[i]) /
+           (static_cast<double>(t_ns[i] - t_ns[i - 1]) * 1e-9);
   }
   return s;
 }
@@ -132,13 +136,14 @@ double difference_noise(const std::vector<double>& s) {
 
 namespace {
 
-// Pearson correlation of a and b (0 when either is constant).
-double pearson(const std::vector<double>& a, const std::vector<double>& b) {
-  const double n = static_cast<double>(a.size());
-  const double ma = std::accumulate(a.begin(), a.end(), 0.0) / n;
-  const double mb = std::accumulate(b.begin(), b.end(), 0.0) / n;
+// Pearson correlation of a and b from element `first` on (0 when either is constant).
+double pearson(const std::vector<double>& a, const std::vector<double>& b, std::size_t first) {
+  const double n = static_cast<double>(a.size() - first);
+  const auto skip = static_cast<std::ptrdiff_t>(first);
+  const double ma = std::accumulate(a.begin() + skip, a.end(), 0.0) / n;
+  const double mb = std::accumulate(b.begin() + skip, b.end(), 0.0) / n;
   double sab = 0.0, saa = 0.0, sbb = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
+  for (std::size_t i = first; i < a.size(); ++i) {
     sab += (a[i] - ma) * (b[i] - mb);
     saa += (a[i] - ma) * (a[i] - ma);
     sbb += (b[i] - mb) * (b[i] - mb);
@@ -146,16 +151,18 @@ double pearson(const std::vector<double>& a, const std::vector<double>& b) {
   return saa > 0.0 && sbb > 0.0 ? sab / std::sqrt(saa * sbb) : 0.0;
 }
 
-// The log's angular speed with the recording's difference operator, read at t + offset.
+// The log's angular speed over the recording's frame intervals, read at t + offset
+// (element 0 unused, as in interval_speed).
 std::vector<double> log_speed(const std::vector<std::int64_t>& t_ns, const PoseLog& log,
                               double offset_ns) {
-  const std::size_t n = t_ns.size();
-  std::vector<double> s(n, 0.0);
+  std::vector<double> s(t_ns.size(), 0.0);
   const std::int64_t off = std::llround(offset_ns);
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t lo = i > 0 ? i - 1 : 0, hi = i + 1 < n ? i + 1 : n - 1;
-    const Eigen::Quaterniond a = log.at(t_ns[lo] + off).q, b = log.at(t_ns[hi] + off).q;
-    s[i] = rotation_angle(a.conjugate() * b) / (static_cast<double>(t_ns[hi] - t_ns[lo]) * 1e-9);
+  Eigen::Quaterniond prev = log.at(t_ns[0] + off).q;
+  for (std::size_t i = 1; i < t_ns.size(); ++i) {
+    const Eigen::Quaterniond q = log.at(t_ns[i] + off).q;
+    s[i] =
+        rotation_angle(prev.conjugate() * q) / (static_cast<double>(t_ns[i] - t_ns[i - 1]) * 1e-9);
+    prev = q;
   }
   return s;
 }
@@ -209,38 +216,49 @@ std::vector<double> grid_correlation(const std::vector<double>& r, const std::ve
 }  // namespace
 
 std::string sync_by_correlation(const std::vector<std::int64_t>& t_ns,
-                                const std::vector<Eigen::Quaterniond>& q, const PoseLog& log,
+                                const std::vector<double>& speed, const PoseLog& log,
                                 AutoSync* out) {
   const std::size_t n = t_ns.size();
-  if (n < 8) return "--clock-offset auto: the recording has too few frames to correlate";
+  if (n < 8 || speed.size() != n) {
+    return "--clock-offset auto: the recording has too few frames to correlate";
+  }
   std::vector<std::int64_t> dt(n - 1);
   for (std::size_t i = 0; i + 1 < n; ++i) dt[i] = t_ns[i + 1] - t_ns[i];
   std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
   const std::int64_t step = dt[dt.size() / 2];  // the frame period: the coarse grid's step
   const std::int64_t span = t_ns.back() - t_ns.front();
   const std::int64_t log_span = log.t_ns.back() - log.t_ns.front();
-  if (log_span < span + 2 * step) {
+  if (log_span < span + step) {
     return log.name + ": spans " + std::to_string(static_cast<double>(log_span) * 1e-9) +
            " s, shorter than the recording (" + std::to_string(static_cast<double>(span) * 1e-9) +
            " s): it cannot cover it at any clock offset";
   }
-  // Both speeds on the grid of one frame period: the recording's from t_ns[0], the log's from
-  // its first sample + one step.
-  const std::vector<double> rec_speed = angular_speed(t_ns, q);
-  const std::size_t nr = static_cast<std::size_t>(span / step) + 1;
+  // Both speeds on a grid of one frame period, each sample at the middle of its interval: the
+  // recording's from its first interval, the log's from its first sample.
+  std::vector<std::int64_t> mid(n - 1);
+  std::vector<double> rec_speed(n - 1);
+  for (std::size_t i = 1; i < n; ++i) {
+    mid[i - 1] = t_ns[i - 1] + (t_ns[i] - t_ns[i - 1]) / 2;
+    rec_speed[i - 1] = speed[i];
+  }
+  const std::size_t nr = static_cast<std::size_t>((mid.back() - mid.front()) / step) + 1;
   std::vector<double> r(nr);
   for (std::size_t i = 0; i < nr; ++i) {
     r[i] = sample(
-        t_ns, rec_speed,
-        static_cast<double>(t_ns.front()) + static_cast<double>(i) * static_cast<double>(step));
+        mid, rec_speed,
+        static_cast<double>(mid.front()) + static_cast<double>(i) * static_cast<double>(step));
   }
-  const std::size_t ng = static_cast<std::size_t>((log_span - 2 * step) / step) + 1;
+  const std::size_t ng = static_cast<std::size_t>((log_span - step) / step);
   std::vector<double> g(ng);
   for (std::size_t j = 0; j < ng; ++j) {
-    const std::int64_t tau = log.t_ns.front() + step + static_cast<std::int64_t>(j) * step;
-    g[j] = rotation_angle(log.at(tau - step).q.conjugate() * log.at(tau + step).q) /
-           (2e-9 * static_cast<double>(step));
+    const std::int64_t tau = log.t_ns.front() + static_cast<std::int64_t>(j) * step;
+    g[j] = rotation_angle(log.at(tau).q.conjugate() * log.at(tau + step).q) /
+           (1e-9 * static_cast<double>(step));
   }
+  if (ng < nr) return log.name + ": shorter than the recording: it cannot cover it";
+  // Grid lag k puts r[0] (at mid.front()) on g[k] (at log start + k step + step / 2).
+  const double grid0 =
+      static_cast<double>(log.t_ns.front() + step / 2) - static_cast<double>(mid.front());
   char buf[320];
   if (const double s = snr(r); s < kMinMotionSnr) {
     std::snprintf(buf, sizeof(buf),
@@ -269,13 +287,12 @@ std::string sync_by_correlation(const std::vector<std::int64_t>& t_ns,
   for (std::size_t k = 0; k < c.size(); ++k) {
     if ((k < lo || k > hi) && c[k] > a.runner_up) {
       a.runner_up = c[k];
-      a.runner_up_ns = log.t_ns.front() + step + static_cast<std::int64_t>(k) * step - t_ns.front();
+      a.runner_up_ns = std::llround(grid0 + static_cast<double>(k) * static_cast<double>(step));
     }
   }
   // Golden-section search of the exact correlation within one period of the best grid lag.
-  const double grid_offset = static_cast<double>(log.t_ns.front() + step - t_ns.front()) +
-                             static_cast<double>(best) * static_cast<double>(step);
-  auto f = [&](double off) { return pearson(rec_speed, log_speed(t_ns, log, off)); };
+  const double grid_offset = grid0 + static_cast<double>(best) * static_cast<double>(step);
+  auto f = [&](double off) { return pearson(speed, log_speed(t_ns, log, off), 1); };
   const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
   double x0 = grid_offset - static_cast<double>(step), x3 = grid_offset + static_cast<double>(step);
   double x1 = x3 - phi * (x3 - x0), x2 = x0 + phi * (x3 - x0);

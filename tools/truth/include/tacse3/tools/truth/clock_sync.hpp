@@ -16,10 +16,10 @@ namespace tacse3::tools::truth {
 
 // From a `candump -L` log taken on the robot's clock: each complete cycle of node 1 (11-bit
 // identifiers) pairs its Timestamp frame's SampleTime (the board's clock, the recording's clock)
-// with the arrival stamp of the frame that completed it. arrival = sample + latency + offset,
-// where latency is the firmware's sample-to-CAN-driver latency, taken as the median of the
-// LatencyP50 values the StatusTiming frames report (0 when none reports one). The bus time of
-// the last frame (about 0.1 ms at 1 Mbit/s) is not modelled.
+// with that frame's arrival stamp (the cycle's first frame). arrival = sample + latency +
+// offset, where latency is the firmware's sample-to-CAN-driver latency, taken as the median of
+// the LatencyP50 values the StatusTiming frames report (0 when none reports one). The frame's
+// own bus time (0.13 ms at 1 Mbit/s, 0.26 ms at 500 kbit/s) is not modelled.
 struct CanSync {
   std::int64_t offset_ns = 0;
   std::size_t cycles = 0;           // complete cycles used
@@ -35,20 +35,21 @@ inline constexpr std::size_t kMaxCanLogBytes = std::size_t{1} << 30;
 std::string read_can_sync(const std::filesystem::path& file, std::int64_t first_ns,
                           std::int64_t last_ns, CanSync* out);
 
-// Angular speed |w| (rad/s) at each t[i] by the central difference of the orientations,
-// angle(q[i-1]^-1 q[i+1]) / (t[i+1] - t[i-1]) (one-sided at the ends).
-std::vector<double> angular_speed(const std::vector<std::int64_t>& t_ns,
-                                  const std::vector<Eigen::Quaterniond>& q);
+// Angular speed (rad/s) over each frame interval: angle(q[i-1]^-1 q[i]) / (t[i] - t[i-1]) at
+// element i; element 0 is 0.
+std::vector<double> interval_speed(const std::vector<std::int64_t>& t_ns,
+                                   const std::vector<Eigen::Quaterniond>& q);
 
 // Noise of a speed series, from its successive differences: 1.4826 MAD(diff) / sqrt(2). A
 // smooth motion barely changes between frames, so this sees the noise, not the motion.
 double difference_noise(const std::vector<double>& s);
 
-// From the shape of the angular speed: the Pearson correlation between the recording's speed
-// (frame times t_ns, orientations from the pipeline: its scale does not matter) and the log's,
-// taken with the same central difference at t + offset, is maximised over every offset at which
-// the log covers the recording: first on a grid of one frame period, then by golden-section
-// search within one period of the best grid point.
+// From the shape of the angular speed. `speed[i]` is the recording's angular speed over the
+// frame interval (t_ns[i-1], t_ns[i]] as the pipeline measures it (its scale does not matter;
+// speed[0] is unused). The Pearson correlation between it and the log's speed over the same
+// intervals read at t + offset is maximised over every offset at which the log covers the
+// recording: first on a grid of one frame period, then by golden-section search within one period
+// of the best grid point.
 struct AutoSync {
   std::int64_t offset_ns = 0;
   double correlation = 0.0;       // at the offset
@@ -64,7 +65,7 @@ inline constexpr double kMaxRunnerUpRatio = 0.9;
 // A series whose range is less than this many noise sigmas has too little motion to sync on.
 inline constexpr double kMinMotionSnr = 10.0;
 std::string sync_by_correlation(const std::vector<std::int64_t>& t_ns,
-                                const std::vector<Eigen::Quaterniond>& q, const PoseLog& log,
+                                const std::vector<double>& speed, const PoseLog& log,
                                 AutoSync* out);
 
 }  // namespace tacse3::tools::truth
