@@ -19,7 +19,8 @@ set(_tacse3_pkg_comp tacse3_deb)
 # tacse3-dbcgen (the generated DBC itself is in /usr/share/tacse3) and tacse3-bench-accuracy
 # (the paper's accuracy tables, a development benchmark).
 set(TACSE3_PACKAGE_PROGRAMS
-    tacse3d tacse3-canmon tacse3-ctl tacse3-replay tacse3-calibrate tacse3-sim tacse3-demo
+    tacse3d tacse3-canmon tacse3-ctl tacse3-replay tacse3-calibrate tacse3-truth tacse3-sim
+    tacse3-demo
     CACHE STRING "Executable targets installed by the .deb when they exist")
 
 set(_tacse3_pkg_programs "")
@@ -135,7 +136,7 @@ string(JOIN "\n" CPACK_PACKAGE_DESCRIPTION
   "TacSE3 pipeline and streams twist and pose over CAN. The package holds the"
   "daemon with its systemd service, the board files, the udev and systemd-networkd"
   "configuration, and the command-line tools (tacse3-canmon, tacse3-ctl,"
-  "tacse3-replay, tacse3-calibrate, tacse3-sim, tacse3-demo).")
+  "tacse3-replay, tacse3-calibrate, tacse3-truth, tacse3-sim, tacse3-demo).")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 # Only the package component, into one package (a monolithic .deb with a component filter).
 set(CPACK_INSTALL_CMAKE_PROJECTS "${CMAKE_BINARY_DIR};${PROJECT_NAME};${_tacse3_pkg_comp};/")
