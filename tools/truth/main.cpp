@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // tacse3-truth: truth.csv for a recording from robot pose logs (docs/truth.md).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -110,19 +112,19 @@ std::string sync_clock(const Options& o, tt::RecordingSource& source, const tr::
   return {};
 }
 
-int execute(const Options& o) {
+// The option combinations and values CLI11 cannot check; "" or the usage error. Fills the rig's
+// fixed poses.
+std::string usage_problem(const Options& o, tr::Rig* rig) {
   if (o.gripper_log.empty() && o.object_log.empty()) {
-    return usage(
-        "give --gripper-log FILE (the gripper moves) or --object-log FILE (the object "
-        "moves), or both");
+    return "give --gripper-log FILE (the gripper moves) or --object-log FILE (the object moves), "
+           "or both";
   }
   if (!o.can_log.empty() && !o.clock_offset.empty()) {
-    return usage("--can-log and --clock-offset both set the clock offset; give one");
+    return "--can-log and --clock-offset both set the clock offset; give one";
   }
   if (o.can_log.empty() && o.clock_offset.empty()) {
-    return usage(
-        "no clock sync: give --clock-offset SECONDS (0 when the robot log has the "
-        "recording's clock), --clock-offset auto, or --can-log FILE");
+    return "no clock sync: give --clock-offset SECONDS (0 when the robot log has the recording's "
+           "clock), --clock-offset auto, or --can-log FILE";
   }
   if (o.clock_offset != "auto" && !o.clock_offset.empty()) {
     std::size_t used = 0;
@@ -133,22 +135,44 @@ int execute(const Options& o) {
       used = 0;
     }
     if (used != o.clock_offset.size() || !std::isfinite(v) || std::abs(v) > 9e9) {
-      return usage("--clock-offset: expected seconds or auto, got \"" + o.clock_offset + "\"");
+      return "--clock-offset: expected seconds or auto, got \"" + o.clock_offset + "\"";
     }
   }
-  tr::Rig rig;
   if (!o.tcp_to_grasp.empty()) {
-    if (std::string e = tr::parse_pose_text(o.tcp_to_grasp, &rig.tcp_to_grasp); !e.empty()) {
-      return usage("--tcp-to-grasp: " + e);
+    if (std::string e = tr::parse_pose_text(o.tcp_to_grasp, &rig->tcp_to_grasp); !e.empty()) {
+      return "--tcp-to-grasp: " + e;
     }
   }
   if (!o.gripper_pose.empty()) {
-    if (!o.gripper_log.empty())
-      return usage("--gripper-pose is for a fixed gripper: drop it or --gripper-log");
-    if (std::string e = tr::parse_pose_text(o.gripper_pose, &rig.fixed_tcp); !e.empty()) {
-      return usage("--gripper-pose: " + e);
+    if (!o.gripper_log.empty()) {
+      return "--gripper-pose is the pose of a still gripper: give it or --gripper-log, not both";
+    }
+    if (std::string e = tr::parse_pose_text(o.gripper_pose, &rig->fixed_tcp); !e.empty()) {
+      return "--gripper-pose: " + e;
     }
   }
+  return {};
+}
+
+void print_summary(const fs::path& out, const std::vector<tacse3::recording::TruthSample>& rows,
+                   std::int64_t offset_ns, const std::string& how) {
+  double max_deg = 0.0, max_mm = 0.0;
+  for (const auto& r : rows) {
+    const double angle = tr::rotation_angle(Eigen::Quaterniond(r.qw, r.qx, r.qy, r.qz));
+    max_deg = std::max(max_deg, angle * 180.0 / std::numbers::pi);
+    max_mm = std::max(max_mm, Eigen::Vector3d(r.px, r.py, r.pz).norm() * 1e3);
+  }
+  std::printf("tacse3-truth: clock offset %.6f s, %s\n", static_cast<double>(offset_ns) * 1e-9,
+              how.c_str());
+  std::printf(
+      "tacse3-truth: wrote %s: %zu rows, object rotation up to %.2f deg, translation up "
+      "to %.2f mm\n",
+      out.c_str(), rows.size(), max_deg, max_mm);
+}
+
+int execute(const Options& o) {
+  tr::Rig rig;
+  if (std::string e = usage_problem(o, &rig); !e.empty()) return usage(e);
   const fs::path out = o.out.empty() ? fs::path(o.rec_dir) / "truth.csv" : fs::path(o.out);
   std::string err;
   if (fs::exists(fs::symlink_status(out)) && !o.force) {
@@ -178,19 +202,7 @@ int execute(const Options& o) {
     return fail(err);
   }
   if (!tacse3::fileio::write_file_atomically(out, tr::truth_csv(rows), &err)) return fail(err);
-  if (o.quiet) return 0;
-  double max_deg = 0.0, max_mm = 0.0;
-  for (const auto& r : rows) {
-    max_deg = std::max(
-        max_deg, tr::rotation_angle(Eigen::Quaterniond(r.qw, r.qx, r.qy, r.qz)) * 180.0 / M_PI);
-    max_mm = std::max(max_mm, Eigen::Vector3d(r.px, r.py, r.pz).norm() * 1e3);
-  }
-  std::printf("tacse3-truth: clock offset %.6f s, %s\n", static_cast<double>(offset_ns) * 1e-9,
-              how.c_str());
-  std::printf(
-      "tacse3-truth: wrote %s: %zu rows, object rotation up to %.2f deg, translation up "
-      "to %.2f mm\n",
-      out.c_str(), rows.size(), max_deg, max_mm);
+  if (!o.quiet) print_summary(out, rows, offset_ns, how);
   return 0;
 }
 

@@ -215,89 +215,69 @@ std::vector<double> grid_correlation(const std::vector<double>& r, const std::ve
 
 }  // namespace
 
-std::string sync_by_correlation(const std::vector<std::int64_t>& t_ns,
-                                const std::vector<double>& speed, const PoseLog& log,
-                                AutoSync* out) {
-  const std::size_t n = t_ns.size();
-  if (n < 8 || speed.size() != n) {
-    return "--clock-offset auto: the recording has too few frames to correlate";
-  }
-  std::vector<std::int64_t> dt(n - 1);
-  for (std::size_t i = 0; i + 1 < n; ++i) dt[i] = t_ns[i + 1] - t_ns[i];
+namespace {
+
+// The median frame period: the coarse grid's step.
+std::int64_t frame_period(const std::vector<std::int64_t>& t_ns) {
+  std::vector<std::int64_t> dt(t_ns.size() - 1);
+  for (std::size_t i = 0; i + 1 < t_ns.size(); ++i) dt[i] = t_ns[i + 1] - t_ns[i];
   std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
-  const std::int64_t step = dt[dt.size() / 2];  // the frame period: the coarse grid's step
-  const std::int64_t span = t_ns.back() - t_ns.front();
-  const std::int64_t log_span = log.t_ns.back() - log.t_ns.front();
-  if (log_span < span + step) {
-    return log.name + ": spans " + std::to_string(static_cast<double>(log_span) * 1e-9) +
-           " s, shorter than the recording (" + std::to_string(static_cast<double>(span) * 1e-9) +
-           " s): it cannot cover it at any clock offset";
-  }
-  // Both speeds on a grid of one frame period, each sample at the middle of its interval: the
-  // recording's from its first interval, the log's from its first sample.
+  return dt[dt.size() / 2];
+}
+
+// Both speeds on a grid of one frame period, each sample at the middle of its interval: the
+// recording's from its first interval (r), the log's from its first sample (g). Grid lag k puts
+// r[0] on g[k]; `grid0` is the clock offset of lag 0.
+struct SpeedGrids {
+  std::vector<double> r, g;
+  double grid0 = 0.0;
+};
+
+SpeedGrids speed_grids(const std::vector<std::int64_t>& t_ns, const std::vector<double>& speed,
+                       const PoseLog& log, std::int64_t step) {
+  const std::size_t n = t_ns.size();
   std::vector<std::int64_t> mid(n - 1);
   std::vector<double> rec_speed(n - 1);
   for (std::size_t i = 1; i < n; ++i) {
     mid[i - 1] = t_ns[i - 1] + (t_ns[i] - t_ns[i - 1]) / 2;
     rec_speed[i - 1] = speed[i];
   }
-  const std::size_t nr = static_cast<std::size_t>((mid.back() - mid.front()) / step) + 1;
-  std::vector<double> r(nr);
-  for (std::size_t i = 0; i < nr; ++i) {
-    r[i] = sample(
-        mid, rec_speed,
-        static_cast<double>(mid.front()) + static_cast<double>(i) * static_cast<double>(step));
+  const double h = static_cast<double>(step);
+  SpeedGrids out;
+  out.r.resize(static_cast<std::size_t>((mid.back() - mid.front()) / step) + 1);
+  for (std::size_t i = 0; i < out.r.size(); ++i) {
+    out.r[i] =
+        sample(mid, rec_speed, static_cast<double>(mid.front()) + static_cast<double>(i) * h);
   }
-  const std::size_t ng = static_cast<std::size_t>((log_span - step) / step);
-  std::vector<double> g(ng);
-  for (std::size_t j = 0; j < ng; ++j) {
+  out.g.resize(static_cast<std::size_t>((log.t_ns.back() - log.t_ns.front()) / step));
+  for (std::size_t j = 0; j < out.g.size(); ++j) {
     const std::int64_t tau = log.t_ns.front() + static_cast<std::int64_t>(j) * step;
-    g[j] = rotation_angle(log.at(tau).q.conjugate() * log.at(tau + step).q) /
-           (1e-9 * static_cast<double>(step));
+    out.g[j] = rotation_angle(log.at(tau).q.conjugate() * log.at(tau + step).q) / (1e-9 * h);
   }
-  if (ng < nr) return log.name + ": shorter than the recording: it cannot cover it";
-  // Grid lag k puts r[0] (at mid.front()) on g[k] (at log start + k step + step / 2).
-  const double grid0 =
-      static_cast<double>(log.t_ns.front() + step / 2) - static_cast<double>(mid.front());
-  char buf[320];
-  if (const double s = snr(r); s < kMinMotionSnr) {
-    std::snprintf(buf, sizeof(buf),
-                  "--clock-offset auto: too little rotation in the recording to sync on (the "
-                  "pipeline's angular speed spans %.1f times its noise, at least %.0f needed); "
-                  "give --can-log or --clock-offset SECONDS",
-                  s, kMinMotionSnr);
-    return buf;
-  }
-  if (const double s = snr(g); s < kMinMotionSnr) {
-    std::snprintf(buf, sizeof(buf),
-                  ": too little rotation to sync on (its angular speed spans %.1f times its "
-                  "noise, at least %.0f needed); give --can-log or --clock-offset SECONDS",
-                  s, kMinMotionSnr);
-    return log.name + buf;
-  }
-  const std::vector<double> c = grid_correlation(r, g);
-  const std::size_t best =
-      static_cast<std::size_t>(std::max_element(c.begin(), c.end()) - c.begin());
-  // The main lobe: the lags around the best where the correlation stays above half of it.
+  out.grid0 = static_cast<double>(log.t_ns.front() + step / 2) - static_cast<double>(mid.front());
+  return out;
+}
+
+// The best correlation outside the main lobe (the lags around `best` where the correlation stays
+// above half of it), and its lag; -1 when every lag is in the lobe.
+std::pair<double, std::size_t> runner_up(const std::vector<double>& c, std::size_t best) {
   std::size_t lo = best, hi = best;
   while (lo > 0 && c[lo - 1] >= 0.5 * c[best]) --lo;
   while (hi + 1 < c.size() && c[hi + 1] >= 0.5 * c[best]) ++hi;
-  AutoSync a;
-  a.runner_up = -1.0;
+  std::pair<double, std::size_t> r{-1.0, 0};
   for (std::size_t k = 0; k < c.size(); ++k) {
-    if ((k < lo || k > hi) && c[k] > a.runner_up) {
-      a.runner_up = c[k];
-      a.runner_up_ns = std::llround(grid0 + static_cast<double>(k) * static_cast<double>(step));
-    }
+    if ((k < lo || k > hi) && c[k] > r.first) r = {c[k], k};
   }
-  // Golden-section search of the exact correlation within one period of the best grid lag.
-  const double grid_offset = grid0 + static_cast<double>(best) * static_cast<double>(step);
-  auto f = [&](double off) { return pearson(speed, log_speed(t_ns, log, off), 1); };
+  return r;
+}
+
+// Golden-section search for the maximum of f on [x0, x3], to 1 µs.
+template <class F>
+double golden_max(F f, double x0, double x3) {
   const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
-  double x0 = grid_offset - static_cast<double>(step), x3 = grid_offset + static_cast<double>(step);
   double x1 = x3 - phi * (x3 - x0), x2 = x0 + phi * (x3 - x0);
   double f1 = f(x1), f2 = f(x2);
-  while (x3 - x0 > 1e3) {  // 1 µs
+  while (x3 - x0 > 1e3) {
     if (f1 > f2) {
       x3 = x2, x2 = x1, f2 = f1;
       x1 = x3 - phi * (x3 - x0), f1 = f(x1);
@@ -306,9 +286,31 @@ std::string sync_by_correlation(const std::vector<std::int64_t>& t_ns,
       x2 = x0 + phi * (x3 - x0), f2 = f(x2);
     }
   }
-  a.offset_ns = std::llround(0.5 * (x0 + x3));
-  a.correlation = f(static_cast<double>(a.offset_ns));
-  a.motion_snr = std::min(snr(r), snr(g));
+  return 0.5 * (x0 + x3);
+}
+
+std::string too_little_motion(const SpeedGrids& grids, const PoseLog& log) {
+  char buf[320];
+  if (const double s = snr(grids.r); s < kMinMotionSnr) {
+    std::snprintf(buf, sizeof(buf),
+                  "--clock-offset auto: too little rotation in the recording to sync on (the "
+                  "pipeline's angular speed spans %.1f times its noise, at least %.0f needed); "
+                  "give --can-log or --clock-offset SECONDS",
+                  s, kMinMotionSnr);
+    return buf;
+  }
+  if (const double s = snr(grids.g); s < kMinMotionSnr) {
+    std::snprintf(buf, sizeof(buf),
+                  ": too little rotation to sync on (its angular speed spans %.1f times its "
+                  "noise, at least %.0f needed); give --can-log or --clock-offset SECONDS",
+                  s, kMinMotionSnr);
+    return log.name + buf;
+  }
+  return {};
+}
+
+std::string poor_match(const AutoSync& a, const PoseLog& log) {
+  char buf[320];
   if (a.correlation < kMinCorrelation) {
     std::snprintf(buf, sizeof(buf),
                   ": --clock-offset auto: the best correlation of the angular speeds is %.2f "
@@ -324,6 +326,42 @@ std::string sync_by_correlation(const std::vector<std::int64_t>& t_ns,
                   static_cast<double>(a.runner_up_ns) * 1e-9);
     return log.name + buf;
   }
+  return {};
+}
+
+}  // namespace
+
+std::string sync_by_correlation(const std::vector<std::int64_t>& t_ns,
+                                const std::vector<double>& speed, const PoseLog& log,
+                                AutoSync* out) {
+  if (t_ns.size() < 8 || speed.size() != t_ns.size()) {
+    return "--clock-offset auto: the recording has too few frames to correlate";
+  }
+  const std::int64_t step = frame_period(t_ns);
+  const std::int64_t span = t_ns.back() - t_ns.front();
+  const std::int64_t log_span = log.t_ns.back() - log.t_ns.front();
+  if (log_span < span + 2 * step) {
+    return log.name + ": spans " + std::to_string(static_cast<double>(log_span) * 1e-9) +
+           " s, shorter than the recording (" + std::to_string(static_cast<double>(span) * 1e-9) +
+           " s): it cannot cover it at any clock offset";
+  }
+  const SpeedGrids grids = speed_grids(t_ns, speed, log, step);
+  if (std::string e = too_little_motion(grids, log); !e.empty()) return e;
+  const std::vector<double> c = grid_correlation(grids.r, grids.g);
+  const std::size_t best =
+      static_cast<std::size_t>(std::max_element(c.begin(), c.end()) - c.begin());
+  const double h = static_cast<double>(step);
+  AutoSync a;
+  const auto [second, second_lag] = runner_up(c, best);
+  a.runner_up = second;
+  a.runner_up_ns = std::llround(grids.grid0 + static_cast<double>(second_lag) * h);
+  // The exact correlation, over the recording's own frame intervals, near the best grid lag.
+  auto f = [&](double off) { return pearson(speed, log_speed(t_ns, log, off), 1); };
+  const double coarse = grids.grid0 + static_cast<double>(best) * h;
+  a.offset_ns = std::llround(golden_max(f, coarse - h, coarse + h));
+  a.correlation = f(static_cast<double>(a.offset_ns));
+  a.motion_snr = std::min(snr(grids.r), snr(grids.g));
+  if (std::string e = poor_match(a, log); !e.empty()) return e;
   *out = a;
   return {};
 }
