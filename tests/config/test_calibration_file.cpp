@@ -13,6 +13,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "tacse3/config/calibration_file.hpp"
@@ -450,6 +451,19 @@ TEST(CalibrationFile, EveryCalibrationFieldHasAKey) {
         "stick_rest_speed_m_s", "stick_confirm_s", "slip_catchup_frames", "slip_smoothing_s"}) {
     EXPECT_EQ(std::count(keys.begin(), keys.end(), k), 1) << k;
   }
+}
+
+}  // namespace
+
+namespace {
+
+// config::Status and protocol::Status share one convention: `!s` is a failure, no bool.
+static_assert(!std::is_constructible_v<bool, cfg::Status>);
+static_assert(!std::is_convertible_v<cfg::Status, bool>);
+
+TEST(CalibrationStatus, NotIsFailure) {
+  EXPECT_FALSE(!cfg::Status());
+  EXPECT_TRUE(!cfg::Status::error("x.toml: bad"));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // tacse3 protocol: command validation: every rejection reason is caught, counted and NACKed.
 #include <gtest/gtest.h>
 
+#include <type_traits>
 #include <vector>
 
 #include "tacse3/protocol/protocol.hpp"
@@ -163,3 +164,12 @@ TEST(Commands, ReceiverCountsEveryRejection) {
   EXPECT_EQ(s.reserved_not_zero, 1u);
   EXPECT_EQ(s.rejected(), 6u);
 }
+
+namespace {
+
+// protocol::Status and config::Status share one convention: `!s` is a failure, no bool.
+static_assert(!std::is_constructible_v<bool, tacse3::protocol::Status>);
+static_assert((!tacse3::protocol::Status::kOk) == false);
+static_assert((!tacse3::protocol::Status::kBadCrc) == true);
+
+}  // namespace

@@ -21,7 +21,9 @@ inline constexpr int kCalibrationVersion = 1;
 inline constexpr std::size_t kMaxCalibrationBytes = std::size_t{1} << 20;
 
 // Success, or a message that names the file and the key at fault. Nothing in this library
-// throws (the daemon reloads the file on SIGHUP and must keep running on a bad file).
+// throws (the daemon reloads the file on SIGHUP and must keep running on a bad file). The
+// convention of protocol::Status: `!s` is true on a failure, and there is no conversion to bool
+// (`if (s)` does not compile), so a check reads the same on both.
 class Status {
  public:
   Status() = default;
@@ -31,7 +33,7 @@ class Status {
     return s;
   }
   bool ok() const noexcept { return message_.empty(); }
-  explicit operator bool() const noexcept { return ok(); }
+  bool operator!() const noexcept { return !ok(); }
   const std::string& message() const noexcept { return message_; }
 
  private:

@@ -19,6 +19,13 @@ enum class Status : std::uint8_t {
   kParseError,      // malformed text (candump line)
 };
 
+// One convention for every tacse3 status type (this one and config::Status): `!s` is true on a
+// failure, and nothing converts to bool, so `if (s)` compiles on neither and a check reads the
+// same everywhere: `if (!s)` or `if (s != Status::kOk)`.
+constexpr bool operator!(Status s) noexcept {
+  return s != Status::kOk;
+}
+
 constexpr const char* to_string(Status s) noexcept {
   switch (s) {
     case Status::kOk:
