@@ -11,15 +11,19 @@
 #include "tacse3/config/board_file.hpp"
 #include "tacse3/firmware/cli.hpp"
 #include "tacse3/firmware/daemon.hpp"
+#include "tacse3/version.hpp"
 
 namespace {
 
 using namespace tacse3;
 
-std::filesystem::path exe_dir() {
-  std::error_code ec;
-  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
-  return ec ? std::filesystem::path() : p.parent_path();
+// Where the calibration came from, for the start-up lines and --check.
+std::string calibration_text(const firmware::CalibrationSource& cal, bool is_default) {
+  if (cal.file.empty()) return "built-in defaults";
+  std::string t = cal.file.string();
+  if (is_default) t += " (the simulator's, the default for a simulated board)";
+  if (!cal.set.fitted) t += " (sets no sensor keys)";
+  return t;
 }
 
 }  // namespace
@@ -35,9 +39,14 @@ int main(int argc, char** argv) {
     std::fputs(firmware::usage_text(), stdout);
     return 0;
   }
+  if (opt.version) {
+    std::printf("tacse3d %s\n", kVersion);
+    return 0;
+  }
+  const std::filesystem::path exe_dir = config::executable_dir();
 
   const std::filesystem::path board_file =
-      config::resolve_board(opt.board, exe_dir(), TACSE3_SOURCE_BOARDS_DIR, &error);
+      config::resolve_board(opt.board, exe_dir, TACSE3_SOURCE_BOARDS_DIR, &error);
   if (board_file.empty()) {
     std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
     return 1;
@@ -53,8 +62,14 @@ int main(int argc, char** argv) {
   }
   if (!opt.can_iface.empty()) board.can.interface = opt.can_iface;
 
+  std::string cal_file = opt.calibration;
+  const bool cal_default = cal_file.empty();
+  if (cal_default) {
+    cal_file =
+        firmware::default_calibration(board, exe_dir, TACSE3_SOURCE_SIM_CALIBRATION).string();
+  }
   firmware::CalibrationSource cal;
-  if (!firmware::load_calibration_source(opt.calibration, &cal, &error)) {
+  if (!firmware::load_calibration_source(cal_file, &cal, &error)) {
     std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
     return 1;
   }
@@ -66,7 +81,8 @@ int main(int argc, char** argv) {
   }
   if (opt.check) {
     std::fputs(config::describe(board).c_str(), stdout);
-    std::printf("  calibration: %s\n", cal.file.empty() ? "built-in defaults" : cal.file.c_str());
+    std::printf("  calibration: %s%s\n", calibration_text(cal, cal_default).c_str(),
+                cal.fitted() ? "" : ": UNCALIBRATED");
     std::printf("ok\n");
     return 0;
   }
@@ -87,13 +103,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tacse3d: %s\n", error.c_str());
     return 1;
   }
+  if (!cal.fitted()) {
+    std::fprintf(stderr,
+                 "tacse3d: UNCALIBRATED: calibration %s; the estimates are not to scale. Give "
+                 "--calibration FILE from tacse3-calibrate (docs/calibration.md)\n",
+                 calibration_text(cal, cal_default).c_str());
+  }
   if (opt.verbosity > 0) {
     const std::string can = !opt.can_socket.empty() ? std::string("socket ") + opt.can_socket
                             : board.can.backend == config::CanBackend::kLog
                                 ? std::string("log ") + board.can.log
                                 : std::string("socketcan ") + board.can.interface;
     std::fprintf(stderr, "tacse3d: board %s (%s), calibration %s, CAN %s\n", board.name.c_str(),
-                 board_file.c_str(), cal.file.empty() ? "built-in" : cal.file.c_str(), can.c_str());
+                 board_file.c_str(), calibration_text(cal, cal_default).c_str(), can.c_str());
   }
   return daemon->run(true);
 }

@@ -29,6 +29,7 @@ PREFIX_MODULE = {
     "hal": "hal",
     "firmware": "firmware",
     "tools": "tools",
+    "version.hpp": "version",  # generated from the CMake project version (cmake/version.hpp.in)
 }
 
 BOTTOM = {"dsp", "protocol", "fileio"}
@@ -43,8 +44,8 @@ ALLOWED = {
     "config": MIDDLE - {"sim", "recording"},
     "recording": MIDDLE - {"sim", "config"},
     "hal": MIDDLE | {"hal"},
-    "firmware": MIDDLE | {"hal", "firmware"},
-    "tools": MIDDLE | {"hal", "tools", "dsp_ref"},
+    "firmware": MIDDLE | {"hal", "firmware", "version"},
+    "tools": MIDDLE | {"hal", "tools", "dsp_ref", "version"},
 }
 
 DSP_STD_ALLOWED = {

@@ -336,6 +336,7 @@ Status parse_impl(std::string_view text, const std::string& origin, CalibrationS
   }
   if (!err) return err;
   if (const auto* t = sub_table(root, "sensor", origin, "sensor", &err)) {
+    set.fitted = true;
     if (Status s =
             apply_sensor_table(*t, "sensor", origin, {&set.sensor[kLeft], &set.sensor[kRight]});
         !s) {
@@ -346,6 +347,7 @@ Status parse_impl(std::string_view text, const std::string& origin, CalibrationS
   const char* names[2] = {"left", "right"};
   for (std::size_t i = 0; i < 2; ++i) {
     if (const auto* t = sub_table(root, names[i], origin, names[i], &err)) {
+      set.fitted = true;
       if (Status s = apply_sensor_table(*t, names[i], origin, {&set.sensor[i]}); !s) return s;
     }
     if (!err) return err;
@@ -672,6 +674,25 @@ std::string type_name(const toml::node& n) {
     default:
       return "a date/time";
   }
+}
+
+std::filesystem::path find_sim_calibration(const std::filesystem::path& exe_dir,
+                                           const std::filesystem::path& source_file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!exe_dir.empty()) {
+    const fs::path installed =
+        (exe_dir / ".." / "share" / "tacse3" / "sim-calibration.toml").lexically_normal();
+    if (fs::is_regular_file(installed, ec)) return installed;
+  }
+  if (!source_file.empty() && fs::is_regular_file(source_file, ec)) return source_file;
+  return {};
+}
+
+std::filesystem::path executable_dir() {
+  std::error_code ec;
+  const auto p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : p.parent_path();
 }
 
 }  // namespace tacse3::config

@@ -10,11 +10,16 @@
 namespace tacse3::firmware {
 
 const char* usage_text() noexcept {
-  return "usage: tacse3d --board NAME|PATH [--calibration FILE] [--can-log FILE|-]\n"
+  return "Usage: tacse3d --board NAME|PATH [--calibration FILE] [--can-log FILE|-]\n"
          "               [--can-socket PATH] [--can-iface IFACE] [--seconds S] [--record DIR]\n"
-         "               [--check] [--quiet|--verbose]\n"
+         "               [--check] [--quiet|--verbose] [--help] [--version]\n"
+         "The tacse3 gripper firmware daemon: reads both tactile sensors, estimates the grasped\n"
+         "object's motion and streams twist and pose over CAN.\n"
          "  --board NAME|PATH    board name (boards/NAME/board.toml) or a board.toml path\n"
-         "  --calibration FILE   calibration from tacse3-calibrate (default: built-in)\n"
+         "                       (default: sim, the simulated board)\n"
+         "  --calibration FILE   calibration from tacse3-calibrate (default: the simulator's\n"
+         "                       sim-calibration.toml on a simulated board, else the built-in\n"
+         "                       defaults, reported as UNCALIBRATED)\n"
          "  --can-log FILE|-     write CAN frames as a candump -L log (\"-\" = stdout)\n"
          "  --can-socket PATH    listen on a Unix socket: frames out and commands in as candump "
          "-L\n"
@@ -23,7 +28,9 @@ const char* usage_text() noexcept {
          "  --seconds S          stop after S seconds of streaming (0 = until SIGTERM/SIGINT)\n"
          "  --record DIR         record both raw sensor streams to DIR\n"
          "  --check              validate board and calibration, print a summary, exit 0/1\n"
-         "  --quiet | --verbose  fewer / more diagnostics on stderr\n";
+         "  --quiet | --verbose  fewer / more diagnostics on stderr\n"
+         "  --help               print this help and exit\n"
+         "  --version            print the version and exit\n";
 }
 
 bool parse_cli(int argc, const char* const* argv, Options* out, std::string* error) {
@@ -62,7 +69,7 @@ bool parse_cli(int argc, const char* const* argv, Options* out, std::string* err
       // An empty value must not mean "none": it would run on the built-in calibration unnoticed.
       if (!take(&o.calibration)) return false;
       if (o.calibration.empty()) {
-        *error = "--calibration needs a file; leave the option out for the built-in calibration";
+        *error = "--calibration needs a file; leave the option out for the default calibration";
         return false;
       }
     } else if (name == "--can-log") {
@@ -109,6 +116,8 @@ bool parse_cli(int argc, const char* const* argv, Options* out, std::string* err
       o.verbosity = 2;
     } else if ((name == "--help" || name == "-h") && !has_inline) {
       o.help = true;
+    } else if (name == "--version" && !has_inline) {
+      o.version = true;
     } else {
       *error = "unknown option \"" + a + "\"";
       return false;

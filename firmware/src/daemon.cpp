@@ -81,6 +81,23 @@ bool load_calibration_source(const std::string& file, CalibrationSource* out, st
   return true;
 }
 
+bool simulated_board(const config::BoardConfig& board) noexcept {
+  bool any = false;
+  for (const auto& s : board.sensors) {
+    if (!s.enabled) continue;
+    if (s.backend != config::CameraBackend::kSim) return false;
+    any = true;
+  }
+  return any;
+}
+
+std::filesystem::path default_calibration(const config::BoardConfig& board,
+                                          const std::filesystem::path& exe_dir,
+                                          const std::filesystem::path& source_sim_calibration) {
+  if (!simulated_board(board)) return {};
+  return config::find_sim_calibration(exe_dir, source_sim_calibration);
+}
+
 bool make_pipeline_config(const config::BoardConfig& board, const CalibrationSource& cal,
                           dsp::DualConfig* dual, std::array<dsp::Calibration, 2>* sensors,
                           std::string* error) {
@@ -688,6 +705,7 @@ void Daemon::finish_summary() {
   summary_.latency_p99_us = engine_->latency_percentile_us(99);
   summary_.dsp_p50_us = engine_->dsp_time_percentile_us(50);
   const EngineStats& e = summary_.engine;
+  if (!calibration_.fitted()) say(0, "UNCALIBRATED run: the estimates below are not to scale");
   say(1,
       "stopped after %.2f s of streaming: %llu samples (%llu pairs, %llu single), %llu cycles "
       "sent, "
@@ -714,8 +732,9 @@ void Daemon::finish_summary() {
     summary_.rotation_error_deg = err;
     say(0,
         "sim truth at the last cycle: rotation (%.2f, %.2f, %.2f) deg; sent estimate (%.2f, %.2f, "
-        "%.2f) deg; error %.2f deg",
-        tru.x(), tru.y(), tru.z(), est.x(), est.y(), est.z(), err);
+        "%.2f) deg; error %.2f deg%s",
+        tru.x(), tru.y(), tru.z(), est.x(), est.y(), est.z(), err,
+        calibration_.fitted() ? "" : " (UNCALIBRATED)");
   }
 }
 

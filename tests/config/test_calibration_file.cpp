@@ -466,4 +466,44 @@ TEST(CalibrationStatus, NotIsFailure) {
   EXPECT_TRUE(!cfg::Status::error("x.toml: bad"));
 }
 
+TEST(CalibrationFitted, OnlyFilesWithSensorKeysAreFitted) {
+  cfg::CalibrationSet set;
+  EXPECT_FALSE(set.fitted);  // built-in defaults
+  ASSERT_TRUE(parse(kHead, &set).ok());
+  EXPECT_FALSE(set.fitted);  // the header alone (the package's /etc/tacse3/calibration.toml)
+  ASSERT_TRUE(parse(kHead + "[meta]\nnote = \"x\"\n", &set).ok());
+  EXPECT_FALSE(set.fitted);
+  ASSERT_TRUE(parse(kHead + "[sensor]\nc_velocity = 0.01\n", &set).ok());
+  EXPECT_TRUE(set.fitted);
+  cfg::CalibrationSet right;
+  ASSERT_TRUE(parse(kHead + "[right]\nc_velocity = 0.01\n", &right).ok());
+  EXPECT_TRUE(right.fitted);
+}
+
+TEST(CalibrationFitted, WrittenSetsReadBackFitted) {
+  // format_calibration writes every key, so whatever a tool saves counts as fitted.
+  std::string text, error;
+  ASSERT_TRUE(cfg::format_calibration(cfg::CalibrationSet{}, &text, &error)) << error;
+  cfg::CalibrationSet set;
+  ASSERT_TRUE(parse(text, &set).ok());
+  EXPECT_TRUE(set.fitted);
+}
+
+TEST(SimCalibration, InstalledCopyFirstThenTheSourceTree) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() / ("tacse3_simcal_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  fs::create_directories(root / "bin");
+  fs::create_directories(root / "share" / "tacse3");
+  const fs::path source = root / "source.toml";
+  std::ofstream(source) << kHead;
+  EXPECT_EQ(cfg::find_sim_calibration(root / "bin", source), source);
+  EXPECT_EQ(cfg::find_sim_calibration({}, source), source);
+  EXPECT_TRUE(cfg::find_sim_calibration(root / "bin", root / "absent.toml").empty());
+  const fs::path installed = root / "share" / "tacse3" / "sim-calibration.toml";
+  std::ofstream(installed) << kHead;
+  EXPECT_EQ(cfg::find_sim_calibration(root / "bin", source), installed);
+  fs::remove_all(root);
+}
+
 }  // namespace

@@ -59,3 +59,39 @@ TEST(Calibration, BadFilesAreRejectedWithFileAndKey) {
   EXPECT_EQ(dual.fusion.extrinsics[1].R_GS(1, 1), -1.0);
   fs::remove_all(dir);
 }
+
+TEST(Calibration, TheSimBoardDefaultsToTheSimulatorsCalibration) {
+  std::string e;
+  BoardConfig sim, uvc;
+  ASSERT_TRUE(load_board(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml", &sim, &e)) << e;
+  ASSERT_TRUE(load_board(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "rpi4-uvc/board.toml", &uvc, &e))
+      << e;
+  EXPECT_TRUE(simulated_board(sim));
+  EXPECT_FALSE(simulated_board(uvc));
+  // No installed copy beside a scratch "bin": the source tree's file.
+  const fs::path dir = scratch_dir();
+  EXPECT_EQ(default_calibration(sim, dir / "bin", TACSE3_SIM_CALIBRATION),
+            fs::path(TACSE3_SIM_CALIBRATION));
+  // A camera board gets no default: the simulator's pads are not its pads.
+  EXPECT_TRUE(default_calibration(uvc, dir / "bin", TACSE3_SIM_CALIBRATION).empty());
+  // A simulated board with one pad switched to a camera is not simulated either.
+  BoardConfig mixed = sim;
+  mixed.sensors[1].backend = config::CameraBackend::kV4l2;
+  EXPECT_FALSE(simulated_board(mixed));
+  fs::remove_all(dir);
+}
+
+TEST(Calibration, OnlyAFileWithSensorKeysIsFitted) {
+  const fs::path dir = scratch_dir();
+  CalibrationSource c;
+  std::string e;
+  ASSERT_TRUE(load_calibration_source("", &c, &e)) << e;
+  EXPECT_FALSE(c.fitted());  // built-in defaults
+  const fs::path header = dir / "header.toml";
+  std::ofstream(header) << "format = \"tacse3-calibration\"\nversion = 1\n";
+  ASSERT_TRUE(load_calibration_source(header.string(), &c, &e)) << e;
+  EXPECT_FALSE(c.fitted());  // the package's /etc/tacse3/calibration.toml
+  ASSERT_TRUE(load_calibration_source(TACSE3_SIM_CALIBRATION, &c, &e)) << e;
+  EXPECT_TRUE(c.fitted());
+  fs::remove_all(dir);
+}

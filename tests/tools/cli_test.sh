@@ -45,6 +45,33 @@ check "replay with a short truth exits 0" test $? -eq 0
 check "the short truth is warned about" contains "$T/stdout_t" \
   "warning: $T/rect/truth.csv ends at t = $(awk -v t="$truth_end" 'BEGIN { printf "%.3f", t * 1e-9 }') s"
 
+# No --calibration: a simulator recording runs on the simulator's calibration, anything else on
+# the built-in defaults, which is UNCALIBRATED at start (stderr) and in the summary.
+check "a sim recording defaults to the simulator's calibration" \
+  contains "$T/stdout" "calibration .*sim-calibration.toml (the simulator's"
+check "a sim recording is not UNCALIBRATED" lacks "$T/stderr" "UNCALIBRATED"
+cp -r "$T/rec" "$T/recn"
+sed -i 's/"generator": *"tacse3-sim"/"generator": "a camera"/' "$T/recn/recording.json"
+"$REPLAY" "$T/recn" --out "$T/x.csv" > "$T/stdout_n" 2> "$T/stderr_n"
+check "replay of a non-sim recording exits 0" test $? -eq 0
+check "it says UNCALIBRATED at start" \
+  contains "$T/stderr_n" "tacse3-replay: UNCALIBRATED: calibration built-in defaults"
+check "and in the summary" contains "$T/stdout_n" "calibration built-in defaults: UNCALIBRATED"
+printf 'format = "tacse3-calibration"\nversion = 1\n' > "$T/header.toml"
+"$REPLAY" "$T/rec" --calibration "$T/header.toml" --out "$T/x.csv" > "$T/stdout_h" 2> "$T/stderr_h"
+check "a header-only calibration is UNCALIBRATED" \
+  contains "$T/stderr_h" "UNCALIBRATED: calibration $T/header.toml (sets no sensor keys)"
+if [ -n "$TACSE3D" ]; then
+  "$TACSE3D" --board sim --check > "$T/check_sim" 2>&1
+  check "tacse3d --board sim --check exits 0" test $? -eq 0
+  check "the sim board defaults to the simulator's calibration" \
+    contains "$T/check_sim" "calibration: .*sim-calibration.toml (the simulator's, the default"
+  check "the sim board is not UNCALIBRATED" lacks "$T/check_sim" "UNCALIBRATED"
+  "$TACSE3D" --board sim --calibration "$T/header.toml" --check > "$T/check_h" 2>&1
+  check "tacse3d with a header-only calibration says UNCALIBRATED" \
+    contains "$T/check_h" "calibration: $T/header.toml (sets no sensor keys): UNCALIBRATED"
+fi
+
 "$REPLAY" "$T/rec" --out - --method paper --mode displacement --sensors left -q > "$T/o2" 2>&1
 check "replay to stdout" test "$(($(wc -l < "$T/o2") - 1))" -eq "$frames"
 

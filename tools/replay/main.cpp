@@ -30,6 +30,15 @@ std::string axis_text(const Eigen::Vector3d& v) {
   return buf;
 }
 
+// Where the calibration came from, for the warning and the summary.
+std::string calibration_text(const std::string& file, bool is_default, bool fitted) {
+  if (file.empty()) return "built-in defaults";
+  std::string t = file;
+  if (is_default) t += " (the simulator's, the default for a simulator recording)";
+  if (!fitted) t += " (sets no sensor keys)";
+  return t;
+}
+
 // The per-frame tracking error, which a controller reading every cycle lives by.
 void print_tracking(std::FILE* report, const tt::TrackingError& t) {
   if (!t.valid) {
@@ -55,7 +64,9 @@ int run(int argc, char** argv) {
       ->required()
       ->check(path);
   app.add_option("--calibration", cal_file,
-                 "calibration file (docs/calibration.md); default: the documented defaults")
+                 "calibration file (docs/calibration.md); default: the simulator's "
+                 "sim-calibration.toml for a simulator recording, else the built-in defaults "
+                 "(reported as UNCALIBRATED)")
       ->check(path);
   app.add_option("--out", out_file, "output CSV, one row per frame ('-' = standard output)")
       ->required()
@@ -80,16 +91,29 @@ int run(int argc, char** argv) {
   (void)tt::parse_method(method, &opt.method);
   (void)tt::parse_mode(mode, &opt.mode);
   (void)tt::parse_sensors(sensors, &opt.sensors);
+  std::string err;
+  auto source = tt::RecordingSource::open(rec_dir, &err);
+  if (!source) return fail(err);
+  const tt::SourceInfo& info = source->info();
+
+  const bool cal_default = cal_file.empty() && tt::is_simulator_recording(info);
+  if (cal_default) {
+    cal_file = tacse3::config::find_sim_calibration(tacse3::config::executable_dir(),
+                                                    TACSE3_SOURCE_SIM_CALIBRATION)
+                   .string();
+  }
   if (!cal_file.empty()) {
     if (auto s = tacse3::config::load_calibration(cal_file, &opt.calibration); !s) {
       return fail(s.message());
     }
   }
-
-  std::string err;
-  auto source = tt::RecordingSource::open(rec_dir, &err);
-  if (!source) return fail(err);
-  const tt::SourceInfo& info = source->info();
+  const std::string cal_text = calibration_text(cal_file, cal_default, opt.calibration.fitted);
+  if (!opt.calibration.fitted) {
+    std::fprintf(stderr,
+                 "tacse3-replay: UNCALIBRATED: calibration %s; the estimates are not to scale. "
+                 "Give --calibration FILE from tacse3-calibrate (docs/calibration.md)\n",
+                 cal_text.c_str());
+  }
 
   tt::EngineSetup setup;
   if (err = tt::make_setup(info, opt, &setup); !err.empty()) return fail(err);
@@ -163,7 +187,7 @@ int run(int argc, char** argv) {
                opt.mode == tt::ProxyMode::kAuto && !tt::pipeline_has_auto()
                    ? " (runs the velocity proxy: the pipeline has no auto switch yet)"
                    : "",
-               cal_file.empty() ? "defaults" : cal_file.c_str());
+               (cal_text + (opt.calibration.fitted ? "" : ": UNCALIBRATED")).c_str());
   std::fprintf(report, "  estimate valid in %.0f%% of frames; wrote %s\n",
                100.0 * sum.valid_fraction, to_stdout ? "standard output" : out_file.c_str());
   if (sum.has_truth) {

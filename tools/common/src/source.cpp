@@ -2,7 +2,19 @@
 // tacse3 tools: the recording-directory frame source (PNG decoding through tacse3_recording).
 #include "tacse3/tools/source.hpp"
 
+#include <nlohmann/json.hpp>
+
 namespace tacse3::tools {
+
+bool is_simulator_recording(const SourceInfo& info) {
+  if (info.extra_json.empty()) return false;
+  const auto j = nlohmann::json::parse(info.extra_json, nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object()) return false;
+  const auto sim = j.find("sim");
+  if (sim == j.end() || !sim->is_object()) return false;
+  const auto gen = sim->find("generator");
+  return gen != sim->end() && gen->is_string() && gen->get<std::string>() == "tacse3-sim";
+}
 
 namespace rec = tacse3::recording;
 

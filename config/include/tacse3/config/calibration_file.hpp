@@ -67,6 +67,9 @@ struct CalibrationSet {
   // Scales that replace sensor[i].rotation_scale / translation_scale with the paper fusion.
   std::array<PaperScales, 2> paper{};
   CalibrationMeta meta;
+  // The file sets at least one sensor key ([sensor], [left] or [right]): a calibration fitted to
+  // some pads. False for the built-in defaults and a file holding only the header.
+  bool fitted = false;
 
   // The per-sensor calibrations for a fusion method (paper: with the [paper] scales).
   std::array<dsp::Calibration, 2> for_method(dsp::FusionMethod method) const;
@@ -103,6 +106,16 @@ Status validate(const CalibrationSet& set, const std::string& origin) noexcept;
 // Text of the velocity proxy enum as written in the file ("velocity", "displacement").
 const char* proxy_name(dsp::VelocityProxy p) noexcept;
 bool parse_proxy_name(std::string_view name, dsp::VelocityProxy* out) noexcept;
+
+// The calibration fitted on the simulator's pads (tools/replay/data/sim-calibration.toml), which
+// a simulated board and a simulator recording use when no --calibration is given. Looked up as
+// <exe_dir>/../share/tacse3/sim-calibration.toml (the installed copy), then `source_file` (the
+// source tree's, for programs run from the build tree). Empty when neither is a regular file.
+std::filesystem::path find_sim_calibration(const std::filesystem::path& exe_dir,
+                                           const std::filesystem::path& source_file);
+
+// The folder of the running program (/proc/self/exe), or an empty path.
+std::filesystem::path executable_dir();
 
 // Names of every key accepted in a sensor table, in file order (for docs and tests).
 std::vector<std::string> sensor_keys();

@@ -8,7 +8,7 @@ namespace tacse3::firmware {
 
 struct Options {
   std::string board = "sim";
-  std::string calibration;  // empty: built-in defaults
+  std::string calibration;  // empty: the simulator's on a simulated board, else built-in defaults
   std::string can_log;      // non-empty: log backend to this file, "-" = stdout
   std::string can_iface;    // non-empty: override [can].interface
   std::string can_socket;   // non-empty: candump -L both ways on a Unix socket at this path
@@ -17,6 +17,7 @@ struct Options {
   bool check = false;
   int verbosity = 1;  // 0 quiet, 1 normal, 2 verbose
   bool help = false;
+  bool version = false;
 };
 
 // false with *error on a usage error (exit status 2).

@@ -34,7 +34,19 @@ class FrameRecorder;
 struct CalibrationSource {
   std::filesystem::path file;  // empty: built-in defaults
   config::CalibrationSet set;
+  // False for the built-in defaults and a file with no sensor keys: the estimates are not to
+  // scale, and the daemon says UNCALIBRATED at start and in its summary.
+  bool fitted() const noexcept { return !file.empty() && set.fitted; }
 };
+
+// True when every enabled sensor of the board is simulated (the sim board).
+bool simulated_board(const config::BoardConfig& board) noexcept;
+
+// The calibration file tacse3d uses without --calibration: the simulator's
+// (config::find_sim_calibration) on a simulated board, else none (empty: built-in defaults).
+std::filesystem::path default_calibration(const config::BoardConfig& board,
+                                          const std::filesystem::path& exe_dir,
+                                          const std::filesystem::path& source_sim_calibration);
 
 // Loads --calibration (or the defaults) and checks it against the board's pipeline settings.
 bool load_calibration_source(const std::string& file, CalibrationSource* out, std::string* error);

@@ -64,6 +64,11 @@ class RecordingSource final : public FrameSource {
   std::array<dsp::FrameView, 2> views_{};
 };
 
+// True for a recording written by the simulator: recording.json holds a "sim" object whose
+// "generator" is "tacse3-sim" (docs/recording-format.md). Such a recording is replayed with the
+// simulator's calibration when none is given.
+bool is_simulator_recording(const SourceInfo& info);
+
 // A FrameView of an 8-bit grey or RGB image held elsewhere.
 dsp::FrameView frame_view(const std::uint8_t* data, int width, int height, int channels) noexcept;
 
