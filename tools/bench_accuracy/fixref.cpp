@@ -17,6 +17,7 @@
 #include "tacse3/dsp_ref/pipeline_ref.hpp"
 #include "tacse3/dsp_ref/smoothing_ref.hpp"
 #include "tacse3/tools/bench.hpp"
+#include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/locked_reference.hpp"
 #include "tacse3/tools/replay.hpp"
 #include "tacse3/tools/sim_source.hpp"
@@ -110,7 +111,7 @@ int main(int argc, char** argv) {
   bool fixed_sampling = false;
   app.add_flag("--ref-fixed-sampling", fixed_sampling,
                "reference block flow on the fixed path's 1/32 px sampling grid (diagnostic)");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = tacse3::tools::parse_command_line(app, argc, argv); rc >= 0) return rc;
   tacse3::dsp_ref::ReferenceOptions ro;
   ro.fixed_point_sampling = fixed_sampling;
 

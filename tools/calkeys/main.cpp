@@ -3,10 +3,10 @@
 // (dsp::kCalibrationFields), so the reference cannot drift from what the reader accepts.
 #include <charconv>
 #include <cstdio>
-#include <cstring>
 #include <string>
 
 #include "tacse3/dsp/calibration_fields.hpp"
+#include "tacse3/tools/cli.hpp"
 
 namespace {
 
@@ -69,16 +69,10 @@ void print_markdown() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 2 && std::strcmp(argv[1], "--markdown") == 0) {
-    print_markdown();
-    return std::ferror(stdout) || std::fflush(stdout) != 0 ? 1 : 0;
-  }
-  if (argc == 2 && std::strcmp(argv[1], "--help") == 0) {
-    std::puts(
-        "Usage: tacse3-calkeys --markdown\n"
-        "Prints the calibration key table of docs/calibration.md from the dsp schema.");
-    return 0;
-  }
-  std::fputs("usage: tacse3-calkeys --markdown (see --help)\n", stderr);
-  return 2;
+  CLI::App app{"Prints the calibration key table of docs/calibration.md from the dsp schema."};
+  bool markdown = false;
+  app.add_flag("--markdown", markdown, "print the table as Markdown (the only output)")->required();
+  if (const int rc = tacse3::tools::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  print_markdown();
+  return tacse3::tools::finish_stdout("tacse3-calkeys", 0);
 }

@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--duration", duration_s,
                  "Stop after this many seconds (live interface; 0 = never)");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = tacse3::tools::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   tacse3::canmon::MonitorOptions opt;
   opt.node = node;

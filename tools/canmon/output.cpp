@@ -81,6 +81,23 @@ std::string time_json(std::uint64_t t) {
 
 }  // namespace
 
+AngleAxisDeg angle_axis_deg(const tp::Quaternion& q) {
+  // The decoded quaternion is only nearly unit (0.00025 LSB): normalise, and take w >= 0 so the
+  // angle is the shorter one.
+  const double n = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  AngleAxisDeg r;
+  if (!(n > 0.0)) return r;
+  const double sign = q.w < 0.0 ? -1.0 : 1.0;
+  const double w = sign * q.w / n;
+  const double v[3] = {sign * q.x / n, sign * q.y / n, sign * q.z / n};
+  const double s = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  const double angle = 2.0 * std::atan2(s, w);
+  if (angle < 1e-9) return r;
+  r.angle_deg = angle * 180.0 / M_PI;
+  for (int i = 0; i < 3; ++i) r.axis[i] = v[i] / s;
+  return r;
+}
+
 std::string fixed(double v, int decimals) {
   if (std::isnan(v)) return "";
   char buf[64];
@@ -310,6 +327,10 @@ void TtySink::draw() {
           line, sizeof line, "  %-12s %10s %10s %10s %10s\n", "q (w x y z)",
           fixed(c.orientation.w, kDecQuat).c_str(), fixed(c.orientation.x, kDecQuat).c_str(),
           fixed(c.orientation.y, kDecQuat).c_str(), fixed(c.orientation.z, kDecQuat).c_str());
+      s += line;
+      const AngleAxisDeg aa = angle_axis_deg(c.orientation);
+      std::snprintf(line, sizeof line, "  %-12s %10.2f deg about (%.3f, %.3f, %.3f)\n", "rotation",
+                    aa.angle_deg, aa.axis[0], aa.axis[1], aa.axis[2]);
       s += line;
       row("p [m]", c.position.x, c.position.y, c.position.z, kDecPosition);
     }

@@ -14,6 +14,14 @@ namespace tacse3::canmon {
 // in JSON. The decimals match each field's LSB, so the text is exact.
 std::string fixed(double v, int decimals);
 
+// A unit quaternion as one rotation: angle in [0, 180] degrees about a unit axis (q and -q give
+// the same rotation). A rotation under 1e-9 rad has the axis (0, 0, 0).
+struct AngleAxisDeg {
+  double angle_deg = 0.0;
+  double axis[3] = {0.0, 0.0, 0.0};
+};
+AngleAxisDeg angle_axis_deg(const tp::Quaternion& q);
+
 // Cycle rows (one per complete cycle) with the node's latest Status appended.
 class CsvSink final : public Sink {
  public:

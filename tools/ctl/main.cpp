@@ -14,6 +14,7 @@
 #include "tacse3/hal/can/socketcan.hpp"
 #include "tacse3/hal/can/unix_channel.hpp"
 #include "tacse3/protocol/protocol.hpp"
+#include "tacse3/tools/cli.hpp"
 
 namespace {
 
@@ -23,8 +24,7 @@ namespace tp = tacse3::protocol;
 // Exit codes (documented in docs/can-protocol.md).
 constexpr int kExitOk = 0;
 constexpr int kExitError = 1;  // I/O, no CAN, bad log
-constexpr int kExitUsage =
-    2;  // arguments out of range (CLI11's own parse errors exit non-zero too)
+constexpr int kExitUsage = 2;  // a bad option or argument (parse_command_line returns it too)
 constexpr int kExitNack = 3;
 constexpr int kExitNoAck = 4;
 
@@ -116,7 +116,24 @@ int main(int argc, char** argv) {
   });
   double separation = 0.0;
   auto* sep = app.add_subcommand("finger-separation", "Set the finger separation");
-  sep->add_option("metres", separation, "Distance between the pads, 0.001 .. 0.25 m")->required();
+  // In metres, like the protocol: "85" is most likely millimetres, so the error says so.
+  const CLI::Validator metres(
+      [](std::string& v) {
+        double m = 0.0;
+        if (!CLI::detail::lexical_cast(v, m)) return "\"" + v + "\" is not a number of metres";
+        if (m >= 0.001 && m <= 0.25) return std::string();
+        std::string hint;
+        if (m > 1.0 && m <= 250.0) {
+          char buf[32];
+          std::snprintf(buf, sizeof(buf), "%g", m / 1000.0);
+          hint = " (for " + v + " mm give " + buf + ")";
+        }
+        return "finger-separation takes metres, 0.001 .. 0.25; got " + v + hint;
+      },
+      "METRES");
+  sep->add_option("metres", separation, "Distance between the pads, 0.001 .. 0.25 m")
+      ->required()
+      ->check(metres);
   sep->callback([&] {
     cmd.code = tp::CommandCode::kSetFingerSeparation;
     cmd.finger_separation_m = separation;
@@ -165,7 +182,7 @@ int main(int argc, char** argv) {
                 : item == "stream"            ? tp::QueryItem::kStream
                                               : tp::QueryItem::kProtocolVersion;
   });
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = tacse3::tools::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   tp::TxConfig tx;
   tx.endpoint.node_id = static_cast<std::uint8_t>(node);
@@ -188,8 +205,7 @@ int main(int argc, char** argv) {
 
   tp::CanFrame frame;
   if (tp::encode(cmd, tx, frame) != tp::Status::kOk) {
-    std::cerr << "tacse3-ctl: " << name << ": argument out of range (finger separation "
-              << "0.001..0.25 m, rate divider 1..120)\n";
+    std::cerr << "tacse3-ctl: " << name << ": the protocol cannot encode this argument\n";
     return kExitUsage;
   }
 

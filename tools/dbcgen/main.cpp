@@ -9,6 +9,7 @@
 
 #include "tacse3/protocol_dbc/dbc_writer.hpp"
 #include "tacse3/protocol_dbc/table_json.hpp"
+#include "tacse3/tools/cli.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"Write the tacse3 CAN DBC (generated from the protocol message table)",
@@ -31,7 +32,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"dbc", "json"}))
       ->capture_default_str();
   app.add_option("-o,--output", output, "Output file, - for stdout")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = tacse3::tools::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   tacse3::protocol::dbc::DbcOptions opt;
   opt.endpoint.node_id = static_cast<std::uint8_t>(node);

@@ -9,6 +9,7 @@
 #include "tacse3/dsp/pipeline.hpp"
 #include "tacse3/sim/object.hpp"
 #include "tacse3/sim/simulator.hpp"
+#include "tacse3/tools/cli.hpp"
 
 namespace {
 
@@ -77,17 +78,23 @@ int run_case(sim::MotionAxis axis, const char* axis_name, double degrees) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Simulates a 20 mm sphere grasped by two DM-Tac pads and rotated 3 deg in the grip, about "
+      "z and then x, and runs the firmware's fixed-point pipeline on it (no files, no CAN). "
+      "Takes no options besides --help and --version."};
+  if (const int rc = tacse3::tools::parse_command_line(app, argc, argv); rc >= 0) return rc;
   std::printf(
       "tacse3-demo: a 20 mm sphere grasped by two simulated 320x240 DM-Tac pads at 120 fps,\n"
       "then rotated in the grip (sticking contact). The fixed-point firmware pipeline\n"
       "estimates the object's rotation in the gripper frame (joint fusion, kinematic\n"
-      "displacement proxy, default calibration):\n");
+      "displacement proxy). UNCALIBRATED: no fitted calibration, the built-in defaults with\n"
+      "the displacement proxy's gain set from the pixel pitch (exact for sticking contact).\n");
   int rc = 0;
   rc |= run_case(sim::MotionAxis::kRz, "z (the pads' normal)", 3.0);
   rc |= run_case(sim::MotionAxis::kRx, "x (along the fingers)", 3.0);
   std::printf(
-      "This runs the default calibration: the axes and signs are right, the magnitudes are\n"
-      "not yet to scale for this simulated gel until tacse3-calibrate fits the gains.\n");
-  return rc;
+      "UNCALIBRATED: small sticking rotations like these need no fit; larger or sliding\n"
+      "motions are not to scale until tacse3-calibrate fits the gains (docs/calibration.md).\n");
+  return tacse3::tools::finish_stdout("tacse3-demo", rc);
 }

@@ -116,7 +116,8 @@ int SocketCanChannel::open_socket(Role role, bool require_up, std::string& error
                    "%s: SocketCAN is not available on this host: socket(PF_CAN, SOCK_RAW, "
                    "CAN_RAW) failed with %s (%s). The kernel has no CAN support loaded "
                    "(CONFIG_CAN / CONFIG_CAN_RAW; try 'modprobe can_raw'); without CAN hardware "
-                   "use the candump log backend",
+                   "use a candump -L log instead of an interface (tacse3d --can-log FILE|-, "
+                   "tacse3-canmon --log FILE|-, tacse3-ctl --log-out FILE|-)",
                    name, errno_name(e), errno_text(e));
     } else {
       format_error(error, "%s: socket(PF_CAN, SOCK_RAW, CAN_RAW) failed: %s (%s)", name,

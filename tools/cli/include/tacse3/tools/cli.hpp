@@ -9,6 +9,8 @@
 #include <cstring>
 #include <string>
 
+#include "tacse3/version.hpp"
+
 namespace tacse3::tools {
 
 // For every option that takes a path: an empty value is a usage error naming the option. It must
@@ -22,9 +24,21 @@ inline CLI::Validator non_empty_path() {
       "");
 }
 
-// Parses the command line. Returns -1 to go on, else the exit code: 0 after --help, 2 for a
-// usage error (the same as tacse3d).
+// The program's name: argv[0] without its folder.
+inline std::string program_name(const char* argv0) {
+  std::string name = argv0 != nullptr ? argv0 : "tacse3";
+  if (const auto slash = name.rfind('/'); slash != std::string::npos) name.erase(0, slash + 1);
+  return name;
+}
+
+// Parses the command line. Returns -1 to go on, else the exit code: 0 after --help or
+// --version, 2 for a usage error (the same as tacse3d). --version prints "NAME VERSION", the
+// line help2man reads; the usage line names the program without its folder.
 inline int parse_command_line(CLI::App& app, int argc, char** argv) {
+  const std::string name = program_name(argc > 0 ? argv[0] : nullptr);
+  if (app.get_name().empty()) app.name(name);
+  app.set_version_flag("--version", name + " " + kVersion,
+                       "print the program's name and version and exit");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
