@@ -41,6 +41,25 @@ if(_tacse3_pkg_programs)
   add_dependencies(tacse3_package_programs ${_tacse3_pkg_programs})
 endif()
 
+# Manual pages (help2man) and bash completion, from the programs' --help and --version.
+include(Tacse3ManCompletion)
+if(_tacse3_pkg_programs)
+  tacse3_man_completion(${_tacse3_pkg_programs})
+  add_dependencies(tacse3_package_programs tacse3_man_completion)
+  if(NOT TACSE3_HELP2MAN)
+    # The package ships a manual page per program: without help2man it cannot be made.
+    add_custom_target(tacse3_need_help2man
+      COMMAND "${CMAKE_COMMAND}" -E echo "the .deb needs help2man for its manual pages: apt-get install help2man, then configure again"
+      COMMAND "${CMAKE_COMMAND}" -E false
+      VERBATIM)
+    add_dependencies(tacse3_package_programs tacse3_need_help2man)
+  endif()
+  install(FILES ${TACSE3_MAN_PAGES} DESTINATION "${CMAKE_INSTALL_DATADIR}/man/man1"
+          COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
+  install(FILES ${TACSE3_COMPLETIONS} DESTINATION "${CMAKE_INSTALL_DATADIR}/bash-completion/completions"
+          COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
+endif()
+
 # Boards: /usr/share/tacse3/boards/<name>/board.toml, the daemon's <exe_dir>/../share lookup.
 file(GLOB _tacse3_pkg_boards CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/boards/*/board.toml")
 foreach(board_file IN LISTS _tacse3_pkg_boards)
@@ -49,6 +68,10 @@ foreach(board_file IN LISTS _tacse3_pkg_boards)
   install(FILES "${board_file}" DESTINATION "${CMAKE_INSTALL_DATADIR}/tacse3/boards/${board}"
           COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
 endforeach()
+# The simulator's calibration: tacse3d --board sim and tacse3-replay of a simulator recording
+# use it when no --calibration is given (config::find_sim_calibration).
+install(FILES "${PROJECT_SOURCE_DIR}/tools/replay/data/sim-calibration.toml"
+        DESTINATION "${CMAKE_INSTALL_DATADIR}/tacse3" COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
 if(EXISTS "${PROJECT_SOURCE_DIR}/protocol/tacse3.dbc")
   install(FILES "${PROJECT_SOURCE_DIR}/protocol/tacse3.dbc" DESTINATION "${CMAKE_INSTALL_DATADIR}/tacse3"
           COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)

@@ -37,7 +37,13 @@ expected() {
       esac
     fi
     case "$kind" in
-      elf | file | conffile) echo "$kind $path" ;;
+      elf)
+        # Every program comes with its manual page and bash completion.
+        echo "elf $path"
+        echo "file /usr/share/man/man1/$(basename "$path").1.gz"
+        echo "file /usr/share/bash-completion/completions/$(basename "$path")"
+        ;;
+      file | conffile) echo "$kind $path" ;;
       boards)
         for board in "$SRC"/boards/*/board.toml; do
           [ -e "$board" ] || continue
@@ -163,7 +169,7 @@ case "${1:-}" in
     ;;
 esac
 
-for tool in cmake cpack dpkg-deb file readelf; do
+for tool in cmake cpack dpkg-deb file readelf help2man; do
   command -v "$tool" >/dev/null || die "$tool not found (scripts/setup.sh installs it)"
 done
 JOBS="${TACSE3_JOBS:-$(nproc)}"

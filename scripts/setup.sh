@@ -20,8 +20,9 @@ PACKAGES=(
   libtomlplusplus-dev libcli11-dev libspng-dev libpng-dev nlohmann-json3-dev
   # hardware backends: MJPEG decode, GPIO, libcamera
   libturbojpeg0-dev libgpiod-dev libcamera-dev
-  # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks
-  libsystemd-dev dpkg-dev file
+  # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks,
+  # help2man for the manual pages made from each program's --help
+  libsystemd-dev dpkg-dev file help2man
   # unit, sysusers and networkd checks of the packaging tests (systemd-analyze verify)
   systemd
   # fuzzing (libFuzzer and sanitizer runtimes for clang)

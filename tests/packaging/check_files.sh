@@ -255,6 +255,8 @@ case_checker() {
   "$SRC/scripts/package.sh" --check "$deb" arm64 >"$TMP/out" 2>&1 || fail "checker rejected a correct package: $(cat "$TMP/out")"
   make_deb missing "$TMP/a64" "libc6 (>= 2.36)" /usr/bin/tacse3-ctl
   expect_fail "a missing program" 'missing: /usr/bin/tacse3-ctl'
+  make_deb noman "$TMP/a64" "libc6 (>= 2.36)" /usr/share/man/man1/tacse3-ctl.1.gz
+  expect_fail "a program without its manual page" 'missing: /usr/share/man/man1/tacse3-ctl.1.gz'
   make_deb extra "$TMP/a64" "libc6 (>= 2.36)" "" /usr/lib/libtacse3_dsp.a
   expect_fail "a static library" 'unexpected file: /usr/lib/libtacse3_dsp.a'
   make_deb wrongarch "$TMP/host" "libc6 (>= 2.36)"
@@ -263,7 +265,7 @@ case_checker() {
   expect_fail "a Depends without libc6" "Depends lacks 'libc6 \(>= 2.36\)'.*|Depends has 'libstdc\+\+6"
   make_deb noconf "$TMP/a64" "libc6 (>= 2.36)" "" "" /etc/tacse3/tacse3d.conf
   expect_fail "a conffile not in conffiles" 'not in conffiles: /etc/tacse3/tacse3d.conf'
-  echo "checker: a correct fake arm64 package passes; missing file, extra file, wrong architecture, wrong Depends, missing conffile are each refused"
+  echo "checker: a correct fake arm64 package passes; missing file, missing manual page, extra file, wrong architecture, wrong Depends, missing conffile are each refused"
 }
 
 run_case() {
