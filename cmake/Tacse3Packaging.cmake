@@ -54,8 +54,10 @@ if(_tacse3_pkg_programs)
       VERBATIM)
     add_dependencies(tacse3_package_programs tacse3_need_help2man)
   endif()
-  install(FILES ${TACSE3_MAN_PAGES} DESTINATION "${CMAKE_INSTALL_DATADIR}/man/man1"
-          COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
+  if(TACSE3_MAN_PAGES)
+    install(FILES ${TACSE3_MAN_PAGES} DESTINATION "${CMAKE_INSTALL_DATADIR}/man/man1"
+            COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
+  endif()
   install(FILES ${TACSE3_COMPLETIONS} DESTINATION "${CMAKE_INSTALL_DATADIR}/bash-completion/completions"
           COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
 endif()
