@@ -19,6 +19,7 @@ set(_tacse3_man_name_tacse3-replay "run the tacse3 firmware pipeline over a reco
 set(_tacse3_man_name_tacse3-calibrate "fit a tacse3 calibration file to recordings")
 set(_tacse3_man_name_tacse3-sim "render a simulated tacse3 grasp as a recording")
 set(_tacse3_man_name_tacse3-demo "simulate a grasp and run the tacse3 pipeline on it")
+set(_tacse3_man_name_tacse3-truth "rebuild a recording's truth.csv from robot pose logs")
 
 function(tacse3_man_completion)
   set(runner "")
