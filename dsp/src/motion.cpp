@@ -72,10 +72,6 @@ Eigen::Vector3d planar_content(const ContactMoments& m, double scale) noexcept {
   return Eigen::Vector3d(turn, tx, ty);
 }
 
-double content_alpha(double dt_s, double smoothing_s) noexcept {
-  return smoothing_s > 0.0 ? dt_s / (smoothing_s + dt_s) : 1.0;
-}
-
 namespace {
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& a) noexcept {
@@ -160,7 +156,6 @@ Status MotionEstimator::configure(const Calibration& cal) noexcept {
   c_displacement_ = cal.c_displacement;
   max_mask_change_ = cal.max_mask_change;
   max_mask_area_ratio_ = cal.max_mask_area_ratio;
-  release_load_rate_ = cal.release_load_rate;
   rotation_scale_ =
       Eigen::Vector3d(cal.rotation_scale[0], cal.rotation_scale[1], cal.rotation_scale[2]);
   displacement_rotation_scale_ = rotation_scale_.cwiseProduct(
@@ -172,27 +167,12 @@ Status MotionEstimator::configure(const Calibration& cal) noexcept {
   solve_options_.lambda_abs = 0.0;
   solve_options_.rcond_min = cal.solve_rcond_min;
   lever_floor_m_ = cal.solve_lever_floor_m;
-  relax_rate_on_ = cal.slip_relax_rate_on;
-  on_frames_ = cal.slip_on_frames;
   min_shift_m_ = cal.slip_min_shift_m;
-  exit_fraction_ = cal.slip_exit_fraction;
-  rest_speed_ = cal.stick_rest_speed_m_s;
-  confirm_s_ = cal.stick_confirm_s;
-  smoothing_s_ = cal.slip_smoothing_s;
+  detector_.configure(cal);
+  release_.configure(cal);
   // Entering or leaving kAuto starts the detector afresh.
-  if (was_auto != (mode_ == VelocityProxy::kAuto)) reset_detector();
+  if (was_auto != (mode_ == VelocityProxy::kAuto)) detector_.reset();
   return Status::kOk;
-}
-
-void MotionEstimator::reset_detector() noexcept {
-  slipping_ = false;
-  evidence_frames_ = 0;
-  unloaded_rest_frames_ = 0;
-  rest_s_ = 0.0;
-  peak_shift_m_ = 0.0;
-  content_.setZero();
-  change_.setZero();
-  have_content_ = false;
 }
 
 void MotionEstimator::reset() noexcept {
@@ -205,7 +185,7 @@ void MotionEstimator::reset() noexcept {
 void MotionEstimator::restart() noexcept {
   // A slide in progress may end during the gap, where its end (which re-anchors) is never seen:
   // the patch anchored before the slide is stale, so the next frame anchors its own Ω.
-  if (slipping_) have_anchor_ = false;
+  if (detector_.slipping()) have_anchor_ = false;
   prev_mask_.fill(0);
   prev_x_nm_.fill(0);
   prev_y_nm_.fill(0);
@@ -218,9 +198,8 @@ void MotionEstimator::restart() noexcept {
   prev_shear_.x.fill(0);
   prev_shear_.y.fill(0);
   have_prev_shear_ = false;
-  load_ = 0.0;
-  load_change_ = 0.0;
-  reset_detector();
+  release_.reset();
+  detector_.reset();
 }
 
 Status MotionEstimator::update(const ContactSet& contact, const VectorField& shear, double dt_s,
@@ -315,89 +294,32 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   out.velocity_points = static_cast<int>(mvel.n);
   out.anchor_overlap_points = static_cast<int>(mh.n);
 
-  // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer),
-  // and its relative rate of fall ρ_L = −EMA(L_t − L_{t−1}) / (EMA(L) · Δt), EMA the
-  // exponential smoothing of X (so ρ_L ≤ 1/slip_smoothing_s at a constant frame period). When
-  // the pads open, the contact loses its load and the gel it lets go of springs back: the
-  // shear's rigid content relaxes about as fast as the load falls, which the detector would
-  // call a slip, and the displacement proxy reads the spring-back as the object moving back.
-  // A grasp, sticking or sliding, holds its load; a release sheds it much faster
-  // (docs/dsp/motion.md, release).
-  // L_{t−1} is prev_sz_ (kept for the sliding rule); a contact's first frame starts the EMA.
+  // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer) and
+  // its relative rate of fall (LoadRelease, docs/dsp/motion.md, release). L_{t−1} is prev_sz_
+  // (kept for the sliding rule).
   if (m.n > 0) {
-    const double alpha = content_alpha(dt_s, smoothing_s_);
-    const double load = static_cast<double>(m.sz);
-    const bool had_load = prev_count_ > 0;
-    load_change_ =
-        had_load ? load_change_ + alpha * ((load - static_cast<double>(prev_sz_)) - load_change_)
-                 : 0.0;
-    load_ = had_load ? load_ + alpha * (load - load_) : load;
-    out.load_drop_rate = load_ > 0.0 ? -load_change_ / (load_ * dt_s) : 0.0;
+    out.load_drop_rate = release_.update(static_cast<double>(m.sz), prev_count_ > 0,
+                                         static_cast<double>(prev_sz_), dt_s);
   }
-  const bool release_rule = release_load_rate_ < kReleaseRuleOff;
-  const bool unloading_fast = release_rule && out.load_drop_rate > release_load_rate_;
+  const bool unloading_fast = release_.unloading_fast(out.load_drop_rate);
 
   // --- kAuto: the stick/slip detector on the rigid-body content of the shear and its increment.
   // The proxy of this frame is the one decided up to the previous frame.
-  const bool sticking = automatic ? !slipping_ : mode_ == VelocityProxy::kDisplacement;
+  const bool sticking = automatic ? !detector_.slipping() : mode_ == VelocityProxy::kDisplacement;
   bool slide_ended = false;
   if (automatic) {
     if (m.n == 0) {
-      reset_detector();  // no contact: the next contact starts sticking (static friction first)
+      detector_.reset();  // no contact: the next contact starts sticking (static friction first)
     } else {
-      // Planar rigid-body content X of the shear read as a contact displacement, smoothed. Its
-      // change dX is read from the increments over Ω_t ∩ Ω_{t−1} (smoothed alike, which equals
-      // the change of the smoothed X while Ω stays the same): cells entering or leaving Ω at the
-      // rim carry shear they did not just gain or lose, and a rim burst read as a relaxation
-      // would start false slips in sticking contacts.
-      const double alpha = content_alpha(dt_s, smoothing_s_);
-      const Eigen::Vector3d& raw = shear_content;
-      const Eigen::Vector3d step = planar_content(mi, c_displacement_ * kQ16Lsb);
-      content_ = have_content_ ? Eigen::Vector3d(content_ + alpha * (raw - content_)) : raw;
-      change_ = have_content_ ? Eigen::Vector3d(change_ + alpha * (step - change_))
-                              : Eigen::Vector3d::Zero();
-      const Eigen::Vector3d& change = change_;
-      have_content_ = true;
-      const double x2 = content_.squaredNorm();
-      out.shear_shift_m = std::sqrt(x2);
-      out.shear_rate_m_s = change.norm() / dt_s;
-      out.slip_relax_rate = x2 > 0.0 ? -content_.dot(change) / (x2 * dt_s) : 0.0;
-      const bool rest = out.shear_rate_m_s < rest_speed_;
-      if (!slipping_) {
-        // Only relaxation beyond the load's own relative fall counts, and none while the load
-        // falls faster than release_load_rate (a release, below).
-        const bool relaxing =
-            out.shear_shift_m > min_shift_m_ && !unloading_fast &&
-            out.slip_relax_rate - (release_rule ? std::max(0.0, out.load_drop_rate) : 0.0) >
-                relax_rate_on_;
-        evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
-        rest_s_ = rest ? rest_s_ + dt_s : 0.0;
-        // Unloaded (|X| ≤ slip_min_shift_m, the least shift an onset needs): any slide it could be
-        // in is slower than slip_min_shift_m · c_velocity / c_displacement (≈ 1.0 mm/s with the
-        // simulator's calibration), one the detector could never call either. At rest for
-        // slip_on_frames frames (the first frame of a contact counts, its change reads zero) it
-        // is confirmed stuck; a loaded contact at rest may be sliding steadily at the friction
-        // limit and needs stick_confirm_s. This drops what the velocity proxy read while the
-        // contact formed (a growing mask's centroid moves with nothing sliding).
-        const bool unloaded = out.shear_shift_m <= min_shift_m_;
-        unloaded_rest_frames_ = rest && unloaded ? unloaded_rest_frames_ + 1 : 0;
-        if (evidence_frames_ >= on_frames_) {
-          slipping_ = true;
-          out.slip_onset = true;
-          evidence_frames_ = 0;
-          peak_shift_m_ = out.shear_shift_m;
-        } else if (rest_s_ >= confirm_s_ || unloaded_rest_frames_ >= on_frames_) {
-          out.stick_confirmed = true;
-        }
-      } else {
-        peak_shift_m_ = std::max(peak_shift_m_, out.shear_shift_m);
-        if (rest && out.shear_shift_m <= exit_fraction_ * peak_shift_m_) {
-          // The slide is over and the gel has relaxed: stick again from here (increments only,
-          // so the residual shear does not move the pose).
-          reset_detector();
-          slide_ended = true;
-        }
-      }
+      const SlipDetector::Step step = detector_.update(
+          shear_content, planar_content(mi, c_displacement_ * kQ16Lsb), out.load_drop_rate, dt_s);
+      const SlipDetector::Features& f = detector_.features();
+      out.shear_shift_m = f.shift_m;
+      out.shear_rate_m_s = f.rate_m_s;
+      out.slip_relax_rate = f.relax_rate;
+      out.slip_onset = step.onset;
+      out.stick_confirmed = step.confirmed;
+      slide_ended = step.ended;
     }
     out.slipping = !sticking;
   }

@@ -70,18 +70,9 @@ std::vector<PointSample> shifted(const std::vector<PointSample>& pts, const Eige
 }
 
 MotionRef::MotionRef(const dsp::Calibration& cal) : cal_(cal) {
+  detector_.configure(cal);
+  release_.configure(cal);
   reset();
-}
-
-void MotionRef::reset_detector() {
-  slipping_ = false;
-  evidence_frames_ = 0;
-  unloaded_rest_frames_ = 0;
-  rest_s_ = 0.0;
-  peak_shift_m_ = 0.0;
-  content_.setZero();
-  change_.setZero();
-  have_content_ = false;
 }
 
 void MotionRef::reset() {
@@ -94,8 +85,8 @@ void MotionRef::reset() {
   prev_sx_.assign(n, 0.0);
   prev_sy_.assign(n, 0.0);
   have_prev_shear_ = false;
-  load_ = load_change_ = 0.0;
-  reset_detector();
+  release_.reset();
+  detector_.reset();
 }
 
 SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<double>& shear_x,
@@ -107,14 +98,11 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   const SlipDecision* const release_follow = follow;
   if (!automatic) follow = nullptr;
   SensorMotionRef out;
-  if (follow != nullptr && follow->slipping != slipping_) {
+  if (follow != nullptr && follow->slipping != detector_.slipping()) {
     // The followed detector switched at the end of the previous frame: onset or exit (the
     // detector restarts, as dsp::MotionEstimator does).
-    if (follow->slipping) {
-      slipping_ = true;
-      evidence_frames_ = 0;
-    } else {
-      reset_detector();
+    detector_.set_slipping(follow->slipping);
+    if (!follow->slipping) {
       // dsp::MotionEstimator set its anchor to Ω at the end of the frame the slide ended.
       if (!release_follow->has_anchor &&
           std::find(prev_mask_.begin(), prev_mask_.end(), 1) != prev_mask_.end()) {
@@ -178,15 +166,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
 
   // Normal load Σ z over Ω, smoothed like X, and its relative rate of fall ρ_L (every mode).
   // L_{t−1} is z_prev (Σ z over the previous mask); a contact's first frame starts the EMA.
-  if (out.points > 0) {
-    const double alpha = cal_.slip_smoothing_s > 0.0 ? dt / (cal_.slip_smoothing_s + dt) : 1.0;
-    const bool had_load = prev_count > 0;
-    load_change_ = had_load ? load_change_ + alpha * ((z_now - z_prev) - load_change_) : 0.0;
-    load_ = had_load ? load_ + alpha * (z_now - load_) : z_now;
-    out.load_drop_rate = load_ > 0.0 ? -load_change_ / (load_ * dt) : 0.0;
-  }
-  const bool release_rule = cal_.release_load_rate < dsp::kReleaseRuleOff;
-  const bool unloading_fast = release_rule && out.load_drop_rate > cal_.release_load_rate;
+  if (out.points > 0) out.load_drop_rate = release_.update(z_now, prev_count > 0, z_prev, dt);
+  const bool unloading_fast = release_.unloading_fast(out.load_drop_rate);
 
   // Planar rigid-body content of the shear read as a contact displacement (brute force).
   auto planar = [&](const std::vector<PointSample>& pts) -> Eigen::Vector3d {
@@ -208,7 +189,7 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     return {inertia > 0.0 ? torque / std::sqrt(k * inertia) : 0.0, mean.x(), mean.y()};
   };
   const bool sticking =
-      automatic ? !slipping_ : cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
+      automatic ? !detector_.slipping() : cal_.velocity_proxy == dsp::VelocityProxy::kDisplacement;
   bool slide_ended = false;
   const Eigen::Vector3d shear_content = planar(shear_pts);
   const double anchor_shift = shear_content.norm();  // |X| unsmoothed, for the anchor rule
@@ -226,52 +207,27 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
                                                                : own_rule);
   if (automatic) {
     if (out.points == 0) {
-      reset_detector();
+      detector_.reset();
     } else {
-      // X over Ω, its change over Ω_t ∩ Ω_{t−1} (the increments), both smoothed.
-      const Eigen::Vector3d& raw = shear_content;
+      // X over Ω, its change over Ω_t ∩ Ω_{t−1} (the increments); the shared detector smooths
+      // and decides, or only smooths while the decisions are followed.
       const Eigen::Vector3d step = planar(incr_pts);
-      const double alpha = cal_.slip_smoothing_s > 0.0 ? dt / (cal_.slip_smoothing_s + dt) : 1.0;
-      content_ = have_content_ ? Eigen::Vector3d(content_ + alpha * (raw - content_)) : raw;
-      change_ = have_content_ ? Eigen::Vector3d(change_ + alpha * (step - change_))
-                              : Eigen::Vector3d::Zero();
-      const Eigen::Vector3d& change = change_;
-      have_content_ = true;
-      const double x2 = content_.squaredNorm();
-      out.shear_shift_m = std::sqrt(x2);
-      out.shear_rate_m_s = change.norm() / dt;
-      out.slip_relax_rate = x2 > 0.0 ? -content_.dot(change) / (x2 * dt) : 0.0;
-      const bool rest = out.shear_rate_m_s < cal_.stick_rest_speed_m_s;
       if (follow != nullptr) {
+        detector_.observe(shear_content, step, out.load_drop_rate, dt);
         // Transitions come from the followed decisions (next frame's `slipping`).
         out.slip_onset = follow->slip_onset;
-        if (!slipping_ && follow->stick_confirmed) out.stick_confirmed = true;
-      } else if (!slipping_) {
-        const bool relaxing =
-            out.shear_shift_m > cal_.slip_min_shift_m && !unloading_fast &&
-            out.slip_relax_rate - (release_rule ? std::max(0.0, out.load_drop_rate) : 0.0) >
-                cal_.slip_relax_rate_on;
-        evidence_frames_ = relaxing ? evidence_frames_ + 1 : 0;
-        rest_s_ = rest ? rest_s_ + dt : 0.0;
-        // Unloaded (|X| ≤ slip_min_shift_m) and at rest for slip_on_frames frames: stuck.
-        const bool unloaded = out.shear_shift_m <= cal_.slip_min_shift_m;
-        unloaded_rest_frames_ = rest && unloaded ? unloaded_rest_frames_ + 1 : 0;
-        if (evidence_frames_ >= cal_.slip_on_frames) {
-          slipping_ = true;
-          out.slip_onset = true;
-          evidence_frames_ = 0;
-          peak_shift_m_ = out.shear_shift_m;
-        } else if (rest_s_ >= cal_.stick_confirm_s ||
-                   unloaded_rest_frames_ >= cal_.slip_on_frames) {
-          out.stick_confirmed = true;
-        }
+        if (!detector_.slipping() && follow->stick_confirmed) out.stick_confirmed = true;
       } else {
-        peak_shift_m_ = std::max(peak_shift_m_, out.shear_shift_m);
-        if (rest && out.shear_shift_m <= cal_.slip_exit_fraction * peak_shift_m_) {
-          reset_detector();
-          slide_ended = true;
-        }
+        const dsp::SlipDetector::Step st =
+            detector_.update(shear_content, step, out.load_drop_rate, dt);
+        out.slip_onset = st.onset;
+        out.stick_confirmed = st.confirmed;
+        slide_ended = st.ended;
       }
+      const dsp::SlipDetector::Features& f = detector_.features();
+      out.shear_shift_m = f.shift_m;
+      out.shear_rate_m_s = f.rate_m_s;
+      out.slip_relax_rate = f.relax_rate;
     }
     out.slipping = !sticking;
   }

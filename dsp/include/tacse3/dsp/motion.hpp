@@ -7,6 +7,8 @@
 
 #include "tacse3/dsp/calibration.hpp"
 #include "tacse3/dsp/contact.hpp"
+#include "tacse3/dsp/load_release.hpp"
+#include "tacse3/dsp/slip_detector.hpp"
 #include "tacse3/dsp/solve3.hpp"
 #include "tacse3/dsp/types.hpp"
 
@@ -60,8 +62,6 @@ void add_normal_equations(const MomentSums& m, Eigen::Matrix3d& AtA, Eigen::Vect
 // through the contact centroid (r = q − c in the pad plane), L = √(Σ |r|² / N) the rms lever, so
 // L·θ = Σ (r × ṽ)_z / √(N Σ |r|²). Used by the kAuto stick/slip detector; zero without points.
 Eigen::Vector3d planar_content(const ContactMoments& m, double scale) noexcept;
-// Weight of the detector's exponential smoothing of X: Δt / (τ + Δt) (1 when τ = 0).
-double content_alpha(double dt_s, double smoothing_s) noexcept;
 
 enum class TranslationSource : std::uint8_t {
   kNone = 0,      // no translation this frame (no contact now or before, or disjoint masks)
@@ -253,28 +253,11 @@ class MotionEstimator {
   bool have_anchor_ = false;
   std::int64_t anchor_count_ = 0;  // |anchor|
 
-  // --- kAuto detector (Calibration fields of the same names).
-  double relax_rate_on_ = 0.0;
-  int on_frames_ = 1;
+  // --- kAuto: the stick/slip detector; slip_min_shift_m is also the anchor's unloaded bar.
+  SlipDetector detector_;
   double min_shift_m_ = 0.0;
-  double exit_fraction_ = 0.0;
-  double rest_speed_ = 0.0;
-  double confirm_s_ = 0.0;
-  bool slipping_ = false;
-  int evidence_frames_ = 0;
-  int unloaded_rest_frames_ = 0;  // consecutive frames at rest with |X| ≤ slip_min_shift_m
-  double rest_s_ = 0.0;
-  double peak_shift_m_ = 0.0;
-  double smoothing_s_ = 0.0;
-  Eigen::Vector3d content_ = Eigen::Vector3d::Zero();  // smoothed X
-  Eigen::Vector3d change_ = Eigen::Vector3d::Zero();   // smoothed dX (over Ω_t ∩ Ω_{t−1})
-  bool have_content_ = false;
-  // Normal load (every mode): smoothed L = Σ z over Ω and its smoothed change (nm); L_{t−1} is
-  // prev_sz_.
-  double release_load_rate_ = 4.0;
-  double load_ = 0.0;
-  double load_change_ = 0.0;
-  void reset_detector() noexcept;
+  // Normal load (every mode): the release rule's load rate; L_{t−1} is prev_sz_.
+  LoadRelease release_;
 };
 
 }  // namespace tacse3::dsp

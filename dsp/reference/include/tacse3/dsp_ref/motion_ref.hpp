@@ -7,7 +7,9 @@
 #include <vector>
 
 #include "tacse3/dsp/calibration.hpp"
+#include "tacse3/dsp/load_release.hpp"
 #include "tacse3/dsp/se3.hpp"
+#include "tacse3/dsp/slip_detector.hpp"
 #include "tacse3/dsp/types.hpp"
 #include "tacse3/dsp_ref/contact_ref.hpp"
 
@@ -114,18 +116,11 @@ class MotionRef {
   std::vector<std::uint8_t> anchor_;
   bool have_anchor_ = false;
   int anchor_count_ = 0;  // |anchor|
-  // kAuto detector state (dsp::MotionEstimator's, in double).
-  bool slipping_ = false;
-  int evidence_frames_ = 0;
-  int unloaded_rest_frames_ = 0;
-  double rest_s_ = 0.0;
-  double peak_shift_m_ = 0.0;
-  Eigen::Vector3d content_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d change_ = Eigen::Vector3d::Zero();
-  bool have_content_ = false;
-  // Normal load (every mode): smoothed Σ z over Ω and its smoothed change (m).
-  double load_ = 0.0, load_change_ = 0.0;
-  void reset_detector();
+  // kAuto: the same decision class as dsp::MotionEstimator; the features fed to it are computed
+  // here in double.
+  dsp::SlipDetector detector_;
+  // Normal load (every mode): the same release rule, fed with Σ z over Ω in metres.
+  dsp::LoadRelease release_;
 };
 
 // dsp::SlipPayback in plain form: the deficit D (fused velocity reading − fused chosen reading,
