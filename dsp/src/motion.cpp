@@ -125,6 +125,16 @@ void add_normal_equations(const MomentSums& m, Eigen::Matrix3d& AtA,
   Atb += m.sqxv;
 }
 
+bool velocity_reads_anchor(const Eigen::Vector3d& shear_content, std::int64_t held,
+                           std::int64_t anchor_cells, std::int64_t contact_cells) noexcept {
+  // The ratio test compares two parts in the same units (strict, so a shear-free frame reads
+  // Ω); the overlap test is in double, exact for cell counts.
+  const bool drag =
+      shear_content.tail<2>().norm() > kVelocityAnchorDragRatio * std::abs(shear_content.x());
+  const auto smaller_set = static_cast<double>(std::min(anchor_cells, contact_cells));
+  return drag && held > 0 && static_cast<double>(held) >= kVelocityAnchorMinOverlap * smaller_set;
+}
+
 SensorMotion velocity_reading(const SensorMotion& m) noexcept {
   SensorMotion v = m;
   if (!m.velocity_differs) return v;
@@ -282,14 +292,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   // velocity proxy's region test below, the detector's raw X and the anchor rule all read it.
   const Eigen::Vector3d shear_content = planar_content(mv, c_displacement_ * kQ16Lsb);
   // The velocity proxy's region (kVelocityAnchorDragRatio above): Ω ∩ anchor while the shear over
-  // Ω is a drag and Ω and the anchor still share enough cells, else Ω. The ratio test compares
-  // two parts in the same units (strict, so a shear-free frame reads Ω); the overlap test is in
-  // double, exact for cell counts.
-  const bool drag =
-      shear_content.tail<2>().norm() > kVelocityAnchorDragRatio * std::abs(shear_content.x());
-  const auto smaller_set = static_cast<double>(std::min(anchor_count_, m.n));
-  out.velocity_anchored =
-      drag && mh.n > 0 && static_cast<double>(mh.n) >= kVelocityAnchorMinOverlap * smaller_set;
+  // Ω is a drag and Ω and the anchor still share enough cells, else Ω.
+  out.velocity_anchored = velocity_reads_anchor(shear_content, mh.n, anchor_count_, m.n);
   const ContactMoments& mvel = out.velocity_anchored ? mh : mv;
   out.velocity_points = static_cast<int>(mvel.n);
   out.anchor_overlap_points = static_cast<int>(mh.n);

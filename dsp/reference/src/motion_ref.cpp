@@ -8,7 +8,7 @@
 
 #include "tacse3/dsp/fixed.hpp"
 #include "tacse3/dsp/geometry.hpp"
-#include "tacse3/dsp/motion.hpp"  // the velocity proxy region constants
+#include "tacse3/dsp/motion.hpp"  // velocity_reads_anchor, planar_content
 
 namespace tacse3::dsp_ref {
 namespace {
@@ -196,11 +196,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   // The velocity proxy's region (dsp::kVelocityAnchorDragRatio's rule): Ω ∩ anchor while the
   // shear is a drag and Ω and the anchor share enough cells; the followed decision if given.
   // A followed choice the reference's own anchor cannot serve (its anchor differs) reads Ω.
-  const bool own_rule =
-      shear_content.tail<2>().norm() >
-          dsp::kVelocityAnchorDragRatio * std::abs(shear_content.x()) &&
-      static_cast<double>(held_pts.size()) >=
-          dsp::kVelocityAnchorMinOverlap * static_cast<double>(std::min(anchor_count_, out.points));
+  const bool own_rule = dsp::velocity_reads_anchor(
+      shear_content, static_cast<std::int64_t>(held_pts.size()), anchor_count_, out.points);
   out.velocity_anchored =
       !held_pts.empty() &&
       (release_follow != nullptr && release_follow->has_anchor ? release_follow->velocity_anchored

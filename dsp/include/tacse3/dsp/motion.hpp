@@ -84,6 +84,11 @@ enum class TranslationSource : std::uint8_t {
 // leaves both); otherwise all of Ω (also on a frame without shear, and before the first anchor).
 inline constexpr double kVelocityAnchorDragRatio = 1.0;
 inline constexpr double kVelocityAnchorMinOverlap = 0.5;
+// The rule above, shared by MotionEstimator and the double reference: true when the velocity
+// proxy reads Ω ∩ anchor. shear_content: planar_content of the shear over Ω (any one scale);
+// held: |Ω ∩ anchor|; anchor_cells: |anchor| (0 without one); contact_cells: |Ω|.
+bool velocity_reads_anchor(const Eigen::Vector3d& shear_content, std::int64_t held,
+                           std::int64_t anchor_cells, std::int64_t contact_cells) noexcept;
 
 // Per-sensor, per-frame result (sensor frame S).
 struct SensorMotion {
