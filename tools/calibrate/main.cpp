@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3-calibrate: fit a calibration file from recordings with truth (docs/calibration.md).
+// tacse3-calibrate: fit a calibration file from recordings with truth, or check one on recordings
+// with truth (docs/calibration.md).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <memory>
@@ -8,6 +9,7 @@
 
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/tools/calibrate.hpp"
+#include "tacse3/tools/calibration_check.hpp"
 #include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/progress.hpp"
 #include "tacse3/tools/source.hpp"
@@ -16,35 +18,65 @@ namespace {
 
 namespace tt = tacse3::tools;
 
+// Exit codes (docs/calibration.md): 0 written / explained, 1 refused, failed or an error, 2 usage.
+constexpr int kFailed = 1;
+constexpr int kUsage = 2;
+
 int fail(const std::string& msg) {
   std::fprintf(stderr, "tacse3-calibrate: error: %s\n", msg.c_str());
-  return 1;
+  return kFailed;
 }
 
-int run(int argc, char** argv) {
-  CLI::App app{
-      "Fits a tacse3 calibration file from recordings that carry truth.csv, by running the "
-      "firmware's fixed-point pipeline over them (docs/calibration.md). The recordings may mix "
-      "stick and slide motions; no label is needed."};
-  std::vector<std::string> dirs;
-  std::string out_file, start_file;
-  int jobs = 2;
-  bool quiet = false;
-  const CLI::Validator path = tt::non_empty_path();
-  app.add_option("REC_DIR", dirs, "recording directories with truth.csv")->required()->check(path);
-  app.add_option("--out", out_file, "calibration file to write (TOML)")->required()->check(path);
-  app.add_option("--start", start_file,
-                 "calibration to start from (default: the documented defaults)")
-      ->check(path);
-  app.add_option("-j,--jobs", jobs, "recordings processed in parallel (default 2)")
-      ->check(CLI::Range(1, 64));
-  app.add_flag("-q,--quiet", quiet, "no progress bar and no fit report");
-  if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
+void warn(const std::string& msg) {
+  std::fprintf(stderr, "tacse3-calibrate: warning: %s\n", msg.c_str());
+}
+
+struct Recordings {
+  std::vector<std::unique_ptr<tt::RecordingSource>> owned;
+  std::vector<tt::FrameSource*> sources;
+};
+
+// Opens every directory; each must carry truth.
+std::string open_recordings(const std::vector<std::string>& dirs, Recordings* out) {
+  for (const auto& d : dirs) {
+    std::string err;
+    auto s = tt::RecordingSource::open(d, &err);
+    if (!s) return err;
+    if (!s->info().has_truth()) {
+      return d + "/truth.csv: missing; calibration and its check need recordings with truth";
+    }
+    out->sources.push_back(s.get());
+    out->owned.push_back(std::move(s));
+  }
+  return {};
+}
+
+int run_check(const std::string& cal_file, const std::vector<std::string>& dirs, int jobs,
+              bool quiet) {
+  tacse3::config::CalibrationSet cal;
+  if (auto s = tacse3::config::load_calibration(cal_file, &cal); !s) return fail(s.message());
+  Recordings rec;
+  if (std::string e = open_recordings(dirs, &rec); !e.empty()) return fail(e);
+  tt::CheckReport report;
+  if (std::string e =
+          tt::check_calibration(rec.sources, cal, jobs, !quiet && tt::stderr_is_tty(), &report);
+      !e.empty()) {
+    return fail(e);
+  }
+  if (!quiet) std::printf("%s", tt::format_check(report).c_str());
+  if (report.passed()) return 0;
+  for (const auto& r : report.recordings) {
+    if (!r.passed()) fail("not explained by " + cal_file + ": " + r.name + ": " + r.reason());
+  }
+  return kFailed;
+}
+
+int run_fit(const std::vector<std::string>& dirs, const std::string& out_file,
+            const std::string& start_file, int jobs, bool quiet, bool force) {
   // Before the fit: a fit can take minutes, and a typo in --out must not cost them.
   if (auto s = tacse3::config::check_calibration_output(out_file); !s) {
     return fail("--out: " + s.message());
   }
-
   tt::CalibrateOptions opt;
   opt.jobs = jobs;
   opt.progress = !quiet && tt::stderr_is_tty();
@@ -57,28 +89,86 @@ int run(int argc, char** argv) {
       return fail(s.message());
     }
   }
-  std::vector<std::unique_ptr<tt::RecordingSource>> owned;
-  std::vector<tt::FrameSource*> sources;
-  for (const auto& d : dirs) {
-    std::string err;
-    auto s = tt::RecordingSource::open(d, &err);
-    if (!s) return fail(err);
-    if (!s->info().has_truth()) {
-      return fail(d + "/truth.csv: missing; calibration needs recordings with truth");
-    }
-    sources.push_back(s.get());
-    owned.push_back(std::move(s));
+  Recordings rec;
+  if (std::string e = open_recordings(dirs, &rec); !e.empty()) return fail(e);
+  for (auto* s : rec.sources) {
+    if (std::string e = tt::check_calibration_recording(s->info()); !e.empty()) return fail(e);
+  }
+  // What the truth alone says is missing is refused before the fit.
+  std::vector<tt::MotionContent> motions;
+  for (auto* s : rec.sources) motions.push_back(tt::motion_from_truth(s->info()));
+  if (std::string m = tt::coverage_message(tt::missing_motions(motions, false)); !m.empty()) {
+    if (!force) return fail("refused: " + m + "\n(or fit anyway with --force)");
+    warn(m);
   }
   tt::CalibrateReport report;
-  if (std::string err = tt::calibrate(sources, opt, &report); !err.empty()) return fail(err);
+  if (std::string err = tt::calibrate(rec.sources, opt, &report); !err.empty()) return fail(err);
+  if (!quiet) std::printf("%s", tt::format_report(report).c_str());
+  for (const auto& p : report.problems) force ? warn(p) : static_cast<void>(fail(p));
+  if (!report.problems.empty() && !force) {
+    return fail("not written: " + out_file + " (" + std::to_string(report.problems.size()) +
+                " problem(s) above; fix them, or write the file anyway with --force)");
+  }
   if (auto s = tacse3::config::save_calibration(out_file, report.calibration); !s) {
     return fail(s.message());
   }
-  if (!quiet) {
-    std::printf("%s", tt::format_report(report).c_str());
+  if (!report.problems.empty()) {
+    warn("wrote " + out_file + " with --force although it fails its check: do not install it");
+  } else if (!quiet) {
     std::printf("tacse3-calibrate: wrote %s\n", out_file.c_str());
   }
   return 0;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{
+      "Fits a tacse3 calibration file from recordings that carry truth.csv, by running the "
+      "firmware's fixed-point pipeline over them, and checks that the fit explains them "
+      "(docs/calibration.md). The recordings may mix stick and slide motions; no label is "
+      "needed.\n"
+      "  tacse3-calibrate REC_DIR... --out FILE     fit, self-check, write\n"
+      "  tacse3-calibrate --check CAL REC_DIR...    check CAL on recordings with truth\n"
+      "A recording is explained when it has valid frames and tacse3-replay's defaults end "
+      "within the tolerance of its truth: 25 % of the motion at the pads, M = |p| + |theta| "
+      "W/2 (W the finger separation), but at least one pixel pitch P; in rotation the same "
+      "divided by W/2.\n"
+      "Exit status: 0 written (or explained), 1 refused, not explained or an error (the file "
+      "is not written), 2 usage error."};
+  std::vector<std::string> dirs;
+  std::string out_file, start_file, check_file;
+  int jobs = 2;
+  bool quiet = false, force = false;
+  const CLI::Validator path = tt::non_empty_path();
+  app.add_option("REC_DIR", dirs, "recording directories with truth.csv")->required()->check(path);
+  auto* out = app.add_option("--out", out_file, "calibration file to write (TOML)")->check(path);
+  app.add_option("--check", check_file,
+                 "evaluate this calibration on the recordings instead of fitting one")
+      ->check(path)
+      ->excludes(out);
+  app.add_option("--start", start_file,
+                 "calibration to start from (default: the documented defaults)")
+      ->check(path);
+  app.add_flag("--force", force,
+               "write the file even if the set lacks motions, a value stops at a bound or the "
+               "self-check fails (each is a warning then)");
+  app.add_option("-j,--jobs", jobs, "recordings processed in parallel (default 2)")
+      ->check(CLI::Range(1, 64));
+  app.add_flag("-q,--quiet", quiet, "no progress bar and no report (errors still go to stderr)");
+  if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  if (!check_file.empty()) {
+    if (!start_file.empty() || force) {
+      std::fprintf(stderr, "tacse3-calibrate: error: --check takes no --start or --force\n");
+      return kUsage;
+    }
+    return run_check(check_file, dirs, jobs, quiet);
+  }
+  if (out_file.empty()) {
+    std::fprintf(stderr,
+                 "tacse3-calibrate: error: give --out FILE to fit a calibration, or --check CAL "
+                 "to check one\nRun with --help for more information.\n");
+    return kUsage;
+  }
+  return run_fit(dirs, out_file, start_file, jobs, quiet, force);
 }
 
 }  // namespace

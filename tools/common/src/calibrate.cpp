@@ -16,6 +16,9 @@
 #include <numbers>
 #include <thread>
 
+#include "tacse3/dsp/calibration_fields.hpp"
+#include "tacse3/tools/calibration_check.hpp"
+#include "tacse3/tools/contact_noise.hpp"
 #include "tacse3/tools/progress.hpp"
 
 namespace tacse3::tools {
@@ -66,57 +69,8 @@ struct RunOutput {
   std::vector<Eigen::Vector3d> omega;  // per-frame ω̄ (kept when asked for)
 };
 
-// Histogram of filter(f^z) over valid grid points (stage 0).
-struct FzHistogram {
-  static constexpr double kLo = -0.25, kHi = 0.25, kBin = 1e-4;  // all values, for the noise
-  static constexpr double kPosHi = 4.0, kPosBin = 1e-3;          // positive values, for p99.9
-  std::vector<std::int64_t> all =
-      std::vector<std::int64_t>(static_cast<std::size_t>((kHi - kLo) / kBin) + 1, 0);
-  std::vector<std::int64_t> pos =
-      std::vector<std::int64_t>(static_cast<std::size_t>(kPosHi / kPosBin) + 1, 0);
-  std::int64_t n = 0, npos = 0;
-  void add(double v) {
-    const double c = std::clamp(v, kLo, kHi);
-    ++all[static_cast<std::size_t>((c - kLo) / kBin)];
-    ++n;
-    if (v > 0.0) {
-      ++pos[static_cast<std::size_t>(std::min(v, kPosHi) / kPosBin)];
-      ++npos;
-    }
-  }
-  void merge(const FzHistogram& o) {
-    for (std::size_t i = 0; i < all.size(); ++i) all[i] += o.all[i];
-    for (std::size_t i = 0; i < pos.size(); ++i) pos[i] += o.pos[i];
-    n += o.n;
-    npos += o.npos;
-  }
-  static double quantile(const std::vector<std::int64_t>& h, std::int64_t total, double q,
-                         double lo, double bin) {
-    if (total == 0) return 0.0;
-    const auto target = static_cast<std::int64_t>(q * static_cast<double>(total));
-    std::int64_t acc = 0;
-    for (std::size_t i = 0; i < h.size(); ++i) {
-      acc += h[i];
-      if (acc > target) return lo + (static_cast<double>(i) + 0.5) * bin;
-    }
-    return lo + static_cast<double>(h.size()) * bin;
-  }
-  double median() const { return quantile(all, n, 0.5, kLo, kBin); }
-  // 1.4826 · median |v − median|: σ of the background noise (most grid points see no contact).
-  double mad_sigma() const {
-    const double med = median();
-    std::vector<std::int64_t> dev(all.size(), 0);
-    for (std::size_t i = 0; i < all.size(); ++i) {
-      const double v = kLo + (static_cast<double>(i) + 0.5) * kBin;
-      dev[std::min(dev.size() - 1, static_cast<std::size_t>(std::abs(v - med) / kBin))] += all[i];
-    }
-    return 1.4826 * quantile(dev, n, 0.5, 0.0, kBin);
-  }
-  double positive_quantile(double q) const { return quantile(pos, npos, q, 0.0, kPosBin); }
-};
-
 std::string run_pass(FrameSource& src, const std::vector<ReplayOptions>& configs,
-                     std::atomic<std::int64_t>* done, FzHistogram* hist,
+                     std::atomic<std::int64_t>* done, PreContactNoise* noise,
                      std::vector<RunOutput>* out, bool keep_omega = false) {
   const SourceInfo& info = src.info();
   std::vector<std::unique_ptr<Replayer>> engines;
@@ -126,6 +80,7 @@ std::string run_pass(FrameSource& src, const std::vector<ReplayOptions>& configs
   }
   out->assign(configs.size(), RunOutput{});
   FrameResult r;
+  std::vector<double> fz;
   for (std::size_t i = 0; i < info.frame_count(); ++i) {
     std::array<const dsp::FrameView*, 2> views{};
     if (std::string e = src.read(i, &views); !e.empty()) return e;
@@ -135,72 +90,21 @@ std::string run_pass(FrameSource& src, const std::vector<ReplayOptions>& configs
       (*out)[k].final_pose = r.pose;
       if (keep_omega) (*out)[k].omega.push_back(r.twist.head<3>());
     }
-    if (hist != nullptr) {
+    if (noise != nullptr && !noise->onset_found()) {
+      fz.clear();
       for (std::size_t s = 0; s < 2; ++s) {
         if (views[s] == nullptr) continue;
         const dsp::SensorFields& f =
             engines[0]->pipeline().sensor(static_cast<dsp::SensorSlot>(s)).fields();
         for (std::size_t g = 0; g < static_cast<std::size_t>(dsp::kGridCount); ++g) {
-          if (f.smoothed_valid.v[g] != 0) hist->add(f.contact.fz_filtered.v[g] * kQ16);
+          if (f.smoothed_valid.v[g] != 0) fz.push_back(f.contact.fz_filtered.v[g] * kQ16);
         }
       }
+      noise->add_frame(i, fz);
     }
     if (done != nullptr) ++*done;
   }
   return {};
-}
-
-// Runs `job(i)` for every recording on `jobs` threads; the first error wins.
-std::string for_each_recording(std::size_t n, int jobs,
-                               const std::function<std::string(std::size_t)>& job) {
-  std::atomic<std::size_t> next{0};
-  std::mutex m;
-  std::string first_error;
-  auto worker = [&] {
-    for (;;) {
-      const std::size_t i = next++;
-      if (i >= n) return;
-      {
-        std::lock_guard<std::mutex> lock(m);
-        if (!first_error.empty()) return;
-      }
-      std::string e = job(i);
-      if (!e.empty()) {
-        std::lock_guard<std::mutex> lock(m);
-        if (first_error.empty()) first_error = e;
-      }
-    }
-  };
-  const int t = std::max(1, std::min<int>(jobs, static_cast<int>(n)));
-  std::vector<std::thread> threads;
-  for (int k = 1; k < t; ++k) threads.emplace_back(worker);
-  worker();
-  for (auto& th : threads) th.join();
-  return first_error;
-}
-
-// Runs a stage over all sources with a progress bar fed from the frame counter.
-std::string run_stage(
-    const std::vector<FrameSource*>& sources, const CalibrateOptions& opt, const std::string& label,
-    const std::function<std::string(std::size_t, std::atomic<std::int64_t>*)>& job) {
-  std::int64_t total = 0;
-  for (auto* s : sources) total += static_cast<std::int64_t>(s->info().frame_count());
-  std::atomic<std::int64_t> done{0};
-  std::atomic<bool> finished{false};
-  std::string err;
-  std::thread runner([&] {
-    err =
-        for_each_recording(sources.size(), opt.jobs, [&](std::size_t i) { return job(i, &done); });
-    finished = true;
-  });
-  ProgressBar bar(label, total, opt.progress);
-  while (!finished.load()) {
-    bar.update(done.load());
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  runner.join();
-  if (err.empty()) bar.finish();
-  return err;
 }
 
 // ---- the least-squares model ------------------------------------------------------------------
@@ -285,6 +189,10 @@ struct FitResult {
   // excited by the other proxy's recordings only and takes that proxy's scale).
   std::array<std::array<bool, 3>, kModes> own_axis{};
   std::array<bool, 3> excited{};
+  // The last iteration's least-squares scale per proxy and axis, and whether the sanity bound
+  // kJointScaleMin .. kJointScaleMax stopped it.
+  std::array<Eigen::Vector3d, kModes> raw_a{Eigen::Vector3d::Ones(), Eigen::Vector3d::Ones()};
+  std::array<std::array<bool, 3>, kModes> clamped{};
 };
 
 FitResult fit_model(const std::vector<FitData>& data, const FitParams& start) {
@@ -376,6 +284,7 @@ FitResult fit_model(const std::vector<FitData>& data, const FitParams& start) {
     for (int m = 0; m < kModes; ++m) {
       const auto mi = static_cast<std::size_t>(m);
       std::array<bool, 3> own{false, false, false};
+      res.clamped[mi] = {false, false, false};
       for (int ax = 0; ax < 3; ++ax) {
         if (!excited[static_cast<std::size_t>(ax)]) continue;
         double num = 0.0, den = 0.0, excite = 0.0;
@@ -387,7 +296,11 @@ FitResult fit_model(const std::vector<FitData>& data, const FitParams& start) {
           excite = std::max(excite, std::abs(data[r].theta(ax)));
         }
         if (excite >= kExciteFloorRad && den > 0.0 && num > 0.0) {
-          p.a[mi](ax) = std::clamp(num / den, kJointScaleMin, kJointScaleMax);
+          const double raw = num / den;
+          res.raw_a[mi](ax) = raw;
+          res.clamped[mi][static_cast<std::size_t>(ax)] =
+              raw < kJointScaleMin || raw > kJointScaleMax;
+          p.a[mi](ax) = std::clamp(raw, kJointScaleMin, kJointScaleMax);
           own[static_cast<std::size_t>(ax)] = true;
         }
       }
@@ -501,20 +414,121 @@ double round_sig(double v, int digits) {
   return std::round(v * e) / e;
 }
 
+// A recording that drove a fitted value, with the value it alone would give.
+struct Driver {
+  std::string name;
+  double value;
+};
+
+// A fitted value stopped at a bound: an error naming the field, the value the data asked for and
+// the recordings that pushed it there (most extreme first, at most five).
+std::string bound_problem(const std::string& field, double wanted, double lo, double hi,
+                          std::vector<Driver> drivers) {
+  const bool high = wanted > hi;
+  std::sort(drivers.begin(), drivers.end(), [&](const Driver& a, const Driver& b) {
+    return high ? a.value > b.value : a.value < b.value;
+  });
+  char b[256];
+  std::snprintf(b, sizeof b, "%s: the fit asks for %.4g, outside its bound %.4g .. %.4g",
+                field.c_str(), wanted, lo, hi);
+  std::string o = b;
+  if (!drivers.empty()) o += "; driven by";
+  for (std::size_t k = 0; k < drivers.size() && k < 5; ++k) {
+    std::snprintf(b, sizeof b, "%s %s (alone %.3g)", k ? "," : "", drivers[k].name.c_str(),
+                  drivers[k].value);
+    o += b;
+  }
+  if (drivers.size() > 5) o += ", ...";
+  o += std::string(". The pipeline reads these recordings' motion ") +
+       (high ? "far smaller" : "far larger") +
+       " than their truth: check that the check table shows valid frames for them and that "
+       "their truth.csv is in G and in metres; drop or re-record them";
+  return o;
+}
+
+// Stage 1: one run with the starting calibration feeds every recording's filter(f^z) to a
+// PreContactNoise. A recording gives a noise estimate when its contact onset comes before the
+// truth starts to move (the grasp closes on a still object); one whose first frames are already
+// in contact shows no onset before the motion (its reference frame holds the contact). The σ is
+// the median over the recordings that give one; contact_tau_on = kOnsetSigma·σ (the onset's
+// bar: about 1e-9 for one cell of Gaussian noise, and contact_min_area_cells drops single cells),
+// contact_tau_off = half of it.
+std::string fit_contact_threshold(const std::vector<FrameSource*>& sources,
+                                  const CalibrateOptions& opt, const config::CalibrationSet& base,
+                                  CalibrateReport* rep) {
+  const std::size_t n = sources.size();
+  std::vector<PreContactNoise> noise(n);
+  std::string err =
+      run_stage(sources, opt.jobs, opt.progress, "calibrate 1/4", [&](std::size_t r, auto* done) {
+        std::vector<ReplayOptions> cfg(1);
+        cfg[0].calibration = base;
+        std::vector<RunOutput> out;
+        return run_pass(*sources[r], cfg, done, &noise[r], &out);
+      });
+  if (!err.empty()) return err;
+  std::vector<double> sigmas;
+  std::string mid_contact;
+  for (std::size_t r = 0; r < n; ++r) {
+    const SourceInfo& in = sources[r]->info();
+    RecordingFit& f = rep->recordings[r];
+    const std::int64_t start_ns = motion_start_ns(in.truth);
+    std::size_t motion_frame = 0;
+    while (motion_frame < in.frame_count() && in.t_ns[motion_frame] < start_ns) ++motion_frame;
+    const PreContactNoise& z = noise[r];
+    f.quiet_frames = z.quiet_frames();
+    if (z.onset_found()) f.contact_onset_frame = static_cast<std::int64_t>(z.onset_frame());
+    if (z.onset_found() && z.onset_frame() < motion_frame) {
+      f.noise_sigma = z.sigma();
+      sigmas.push_back(z.sigma());
+    } else {
+      char b[256];
+      std::snprintf(b, sizeof b,
+                    "%s: no contact forms before the motion starts (frame %zu): the recording "
+                    "starts mid-contact (or the pads never touch); record frames with the pads "
+                    "open first",
+                    in.name.c_str(), motion_frame);
+      mid_contact += std::string(mid_contact.empty() ? "" : "\n") + b;
+    }
+  }
+  if (sigmas.empty()) {
+    return "no recording gives the f^z noise before contact, so contact_tau_on cannot be set:\n" +
+           mid_contact;
+  }
+  if (!mid_contact.empty()) {
+    rep->notes.push_back("left out of the noise estimate (the others give it):\n" + mid_contact);
+  }
+  std::nth_element(sigmas.begin(), sigmas.begin() + static_cast<std::ptrdiff_t>(sigmas.size() / 2),
+                   sigmas.end());
+  const double sigma = sigmas[sigmas.size() / 2];
+  rep->fz_noise_sigma = sigma;
+  if (!(sigma > 0.0)) {
+    return "the f^z before contact has no noise at all (sigma 0), so contact_tau_on cannot be "
+           "set from it: are the frames before contact identical copies?";
+  }
+  rep->contact_tau_on = round_sig(PreContactNoise::kOnsetSigma * sigma, 3);
+  rep->contact_tau_off = round_sig(0.5 * PreContactNoise::kOnsetSigma * sigma, 3);
+  return {};
+}
+
 }  // namespace
+
+std::string check_calibration_recording(const SourceInfo& info) {
+  if (!info.has_truth()) {
+    return info.name + ": has no truth.csv; calibration needs recordings with truth";
+  }
+  if (info.frame_count() < kMinCalibrationFrames) {
+    return info.name + ": " + std::to_string(info.frame_count()) +
+           " frame(s); calibration needs at least " + std::to_string(kMinCalibrationFrames) +
+           " per recording (a grasp, a motion and a rest)";
+  }
+  return {};
+}
 
 std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateOptions& opt,
                       CalibrateReport* report) {
   if (sources.empty()) return "no recordings given";
   for (auto* s : sources) {
-    if (!s->info().has_truth()) {
-      return s->info().name + ": has no truth.csv; calibration needs recordings with truth";
-    }
-    if (s->info().frame_count() < kMinCalibrationFrames) {
-      return s->info().name + ": " + std::to_string(s->info().frame_count()) +
-             " frame(s); calibration needs at least " + std::to_string(kMinCalibrationFrames) +
-             " per recording (a grasp, a motion and a rest)";
-    }
+    if (std::string e = check_calibration_recording(s->info()); !e.empty()) return e;
   }
   auto log = [&](const std::string& m) {
     if (opt.log) opt.log(m);
@@ -553,61 +567,49 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     c.c_displacement *= ratio;
   }
 
-  // ---- stage 0: starting calibration in both proxies; f^z noise for τ --------------------
-  log("stage 1/3: starting calibration, contact threshold from the f^z noise");
-  std::vector<FzHistogram> hists(n);
-  std::vector<std::vector<RunOutput>> out0(n);
-  std::string err = run_stage(sources, opt, "calibrate 1/3", [&](std::size_t r, auto* done) {
-    std::vector<ReplayOptions> cfg(2);
-    for (int m = 0; m < kModes; ++m) {
-      cfg[static_cast<std::size_t>(m)].calibration = base;
-      cfg[static_cast<std::size_t>(m)].mode = mode_of(m);
-    }
-    return run_pass(*sources[r], cfg, done, &hists[r], &out0[r], true);
-  });
-  if (!err.empty()) return err;
-  FzHistogram hist;
-  for (const auto& h : hists) hist.merge(h);
-  rep.fz_noise_sigma = hist.mad_sigma();
-  rep.fz_contact_p999 = hist.positive_quantile(0.999);
-  double tau_on = round_sig(6.0 * rep.fz_noise_sigma, 3);
-  const double tau_cap = 0.5 * rep.fz_contact_p999;
-  if (!(tau_on >= 0.005)) {
-    tau_on = 0.005;
-    rep.notes.push_back("contact_tau_on raised to its floor 0.005 (f^z noise below 1e-3)");
-  }
-  if (tau_cap > 0.0 && tau_on > tau_cap) {
-    tau_on = round_sig(tau_cap, 3);
-    rep.notes.push_back("contact_tau_on capped at half the 99.9th percentile of f^z (noisy f^z)");
-  }
-  const double tau_off = round_sig(std::min(tau_on, 3.0 * rep.fz_noise_sigma), 3);
+  // ---- stage 1: the contact threshold from the f^z noise before contact ------------------
+  log("stage 1/4: contact threshold from the f^z noise before contact");
+  if (std::string e = fit_contact_threshold(sources, opt, base, &rep); !e.empty()) return e;
   for (auto& c : base.sensor) {
-    c.contact_tau_on = tau_on;
-    c.contact_tau_off = std::max(0.0, tau_off);
+    c.contact_tau_on = rep.contact_tau_on;
+    c.contact_tau_off = rep.contact_tau_off;
   }
 
   // ---- stage 1: one run per proxy and shear component -------------------------------------
-  log("stage 2/3: one run per proxy and shear component (d, r, k)");
-  std::vector<std::vector<RunOutput>> out1(n);
-  err = run_stage(sources, opt, "calibrate 2/3", [&](std::size_t r, auto* done) {
-    std::vector<ReplayOptions> cfg;
-    for (int m = 0; m < kModes; ++m) {
-      for (int c = 0; c < kComponents; ++c) {
-        ReplayOptions o;
-        o.calibration = base;
-        o.mode = mode_of(m);
-        for (auto& s : o.calibration.sensor) {
-          s.shear_gain_d = c == 0 ? 1.0 : 0.0;
-          s.shear_gain_r = c == 1 ? 1.0 : 0.0;
-          s.shear_gain_k = c == 2 ? 1.0 : 0.0;
-          s.rotation_scale = {1.0, 1.0, 1.0};
-          s.displacement_rotation_ratio = {1.0, 1.0, 1.0};
+  log("stage 2/4: the starting gains and one run per proxy and shear component (d, r, k)");
+  std::vector<std::vector<RunOutput>> out1(n), out0(n);
+  std::string err =
+      run_stage(sources, opt.jobs, opt.progress, "calibrate 2/4", [&](std::size_t r, auto* done) {
+        // The starting gains with the fitted threshold, in both proxies (which proxy explains the
+        // recording, and the report's "before"), then the six component runs.
+        std::vector<ReplayOptions> cfg(kModes);
+        for (int m = 0; m < kModes; ++m) {
+          cfg[static_cast<std::size_t>(m)].calibration = base;
+          cfg[static_cast<std::size_t>(m)].mode = mode_of(m);
         }
-        cfg.push_back(o);
-      }
-    }
-    return run_pass(*sources[r], cfg, done, nullptr, &out1[r]);
-  });
+        for (int m = 0; m < kModes; ++m) {
+          for (int c = 0; c < kComponents; ++c) {
+            ReplayOptions o;
+            o.calibration = base;
+            o.mode = mode_of(m);
+            for (auto& s : o.calibration.sensor) {
+              s.shear_gain_d = c == 0 ? 1.0 : 0.0;
+              s.shear_gain_r = c == 1 ? 1.0 : 0.0;
+              s.shear_gain_k = c == 2 ? 1.0 : 0.0;
+              s.rotation_scale = {1.0, 1.0, 1.0};
+              s.displacement_rotation_ratio = {1.0, 1.0, 1.0};
+            }
+            cfg.push_back(o);
+          }
+        }
+        std::vector<RunOutput> all;
+        if (std::string e = run_pass(*sources[r], cfg, done, nullptr, &all, true); !e.empty())
+          return e;
+        out0[r].assign(all.begin(), all.begin() + kModes);
+        out1[r].assign(all.begin() + kModes, all.end());
+        for (auto& o : out1[r]) o.omega.clear();
+        return std::string{};
+      });
   if (!err.empty()) return err;
   for (std::size_t r = 0; r < n; ++r) {
     for (int m = 0; m < kModes; ++m) {
@@ -672,25 +674,61 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     rep.recordings_per_mode[static_cast<std::size_t>(m)] =
         static_cast<int>(std::count(fit.p.mode.begin(), fit.p.mode.end(), m));
   }
+  // Recordings of proxy m, each with the gain factor it alone would give.
+  auto mode_drivers = [&](int m) {
+    std::vector<Driver> d;
+    for (std::size_t r = 0; r < n; ++r) {
+      if (fit.p.mode[r] != m) continue;
+      const Eigen::Vector3d e =
+          fit.p.a[static_cast<std::size_t>(m)].cwiseProduct(combine(data[r], fit.p.s, m));
+      if (e.squaredNorm() > 0.0)
+        d.push_back({sources[r]->info().name, e.dot(data[r].theta) / e.squaredNorm()});
+    }
+    return d;
+  };
+  std::array<double, kModes> gain{base.sensor[0].c_velocity, base.sensor[0].c_displacement};
+  for (int m = 0; m < kModes; ++m) {
+    const auto mi = static_cast<std::size_t>(m);
+    const char* key = m == 0 ? "c_velocity" : "c_displacement";
+    if (rep.recordings_per_mode[mi] == 0) {
+      rep.notes.push_back(std::string("no recording is explained by the ") + to_string(mode_of(m)) +
+                          " proxy: " + key + " is kept at the start value");
+      continue;
+    }
+    // The proxy gain may move by kGainRange either way from the start: further only fits noise.
+    constexpr double kGainRange = 50.0;
+    const double k = fit.p.k[mi];
+    const dsp::CalibrationField* f = dsp::find_calibration_field(key);
+    const double schema_hi = f != nullptr ? f->hi : HUGE_VAL;
+    const double lo = gain[mi] / kGainRange, hi = std::min(gain[mi] * kGainRange, schema_hi);
+    const double wanted = gain[mi] * k;
+    if (!(wanted >= lo && wanted <= hi)) {
+      std::vector<Driver> d = mode_drivers(m);
+      for (auto& x : d) x.value *= gain[mi];
+      rep.problems.push_back(bound_problem(key, wanted, lo, hi, d));
+    }
+    gain[mi] = round_sig(std::clamp(wanted, lo, hi), 4);
+  }
+  for (int m = 0; m < kModes; ++m) {
+    for (int ax = 0; ax < 3; ++ax) {
+      if (!fit.clamped[static_cast<std::size_t>(m)][static_cast<std::size_t>(ax)]) continue;
+      std::vector<Driver> d;
+      for (std::size_t r = 0; r < n; ++r) {
+        const double e = fit.p.k[static_cast<std::size_t>(m)] * combine(data[r], fit.p.s, m)(ax);
+        if (fit.p.mode[r] == m && std::abs(data[r].theta(ax)) >= kExciteFloorRad && e != 0.0)
+          d.push_back({sources[r]->info().name, data[r].theta(ax) / e});
+      }
+      rep.problems.push_back(bound_problem(
+          std::string(m == 0 ? "rotation_scale " : "displacement proxy scale ") + "xyz"[ax],
+          fit.raw_a[static_cast<std::size_t>(m)](ax), kJointScaleMin, kJointScaleMax, d));
+    }
+  }
   for (auto& c : fitted.sensor) {
     c.shear_gain_d = round_sig(fit.p.s[0], 4);
     c.shear_gain_r = round_sig(fit.p.s[1], 4);
     c.shear_gain_k = round_sig(fit.p.s[2], 4);
-    for (int m = 0; m < kModes; ++m) {
-      double& gain = m == 0 ? c.c_velocity : c.c_displacement;
-      const double hi = m == 0 ? 100.0 : 1.0;
-      if (rep.recordings_per_mode[static_cast<std::size_t>(m)] == 0) {
-        rep.notes.push_back(std::string("no recording is explained by the ") +
-                            to_string(mode_of(m)) + " proxy: its gain is kept at the start value");
-        continue;
-      }
-      const double k = std::clamp(fit.p.k[static_cast<std::size_t>(m)], 0.02, 50.0);
-      if (k != fit.p.k[static_cast<std::size_t>(m)]) {
-        rep.notes.push_back(std::string("the ") + to_string(mode_of(m)) +
-                            " proxy gain hit its sanity bound (x0.02 .. x50 of the start value)");
-      }
-      gain = round_sig(std::clamp(gain * k, 1e-9, hi), 4);
-    }
+    c.c_velocity = gain[0];
+    c.c_displacement = gain[1];
     for (int ax = 0; ax < 3; ++ax)
       c.rotation_scale[static_cast<std::size_t>(ax)] = round_sig(fit.p.a[0](ax), 4);
     for (int ax = 0; ax < 3; ++ax)
@@ -720,7 +758,7 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
   // (ρ_on, frames); the candidate with the smallest summed final-pose error (the same relative
   // rotation and translation cost that chose each recording's proxy above) wins. Only truth
   // poses are used, never a regime label.
-  log("stage 2b/3: stick/slip detector thresholds (kAuto, one run per candidate)");
+  log("stage 2b/4: stick/slip detector thresholds (kAuto, one run per candidate)");
   // The minimum shift is a candidate too: the grasp itself leaves a small planar shear content
   // (the bulge is not exactly curl- and translation-free once d enters the shear), and a
   // torsion that starts from it reads as that content relaxing. That content can exceed the
@@ -746,23 +784,24 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     return c;
   }();
   std::vector<std::vector<RunOutput>> outd(n);
-  err = run_stage(sources, opt, "calibrate 2b/3", [&](std::size_t r, auto* done) {
-    std::vector<ReplayOptions> cfg;
-    for (const auto& cand : kCandidates) {
-      ReplayOptions o;
-      o.calibration = fitted;
-      for (auto& c : o.calibration.sensor) {
-        c.slip_relax_rate_on = cand.relax_rate_on;
-        c.slip_on_frames = cand.on_frames;
-        c.slip_min_shift_m = cand.min_shift_m;
-      }
-      o.method = dsp::FusionMethod::kJoint;
-      o.mode = ProxyMode::kAuto;
-      for (auto& p : o.calibration.paper) p = config::PaperScales{};
-      cfg.push_back(o);
-    }
-    return run_pass(*sources[r], cfg, done, nullptr, &outd[r]);
-  });
+  err =
+      run_stage(sources, opt.jobs, opt.progress, "calibrate 2b/4", [&](std::size_t r, auto* done) {
+        std::vector<ReplayOptions> cfg;
+        for (const auto& cand : kCandidates) {
+          ReplayOptions o;
+          o.calibration = fitted;
+          for (auto& c : o.calibration.sensor) {
+            c.slip_relax_rate_on = cand.relax_rate_on;
+            c.slip_on_frames = cand.on_frames;
+            c.slip_min_shift_m = cand.min_shift_m;
+          }
+          o.method = dsp::FusionMethod::kJoint;
+          o.mode = ProxyMode::kAuto;
+          for (auto& p : o.calibration.paper) p = config::PaperScales{};
+          cfg.push_back(o);
+        }
+        return run_pass(*sources[r], cfg, done, nullptr, &outd[r]);
+      });
   if (!err.empty()) return err;
   {
     std::array<double, kCandidateCount> cost{};
@@ -805,9 +844,9 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
   }
 
   // ---- stage 2: validation runs; paper-fusion and translation scales -----------------------
-  log("stage 3/3: validation runs (joint, paper) with the fitted gains");
+  log("stage 3/4: validation runs (joint, paper) with the fitted gains");
   std::vector<std::vector<RunOutput>> out2(n);
-  err = run_stage(sources, opt, "calibrate 3/3", [&](std::size_t r, auto* done) {
+  err = run_stage(sources, opt.jobs, opt.progress, "calibrate 3/4", [&](std::size_t r, auto* done) {
     std::vector<ReplayOptions> cfg;
     for (auto method : {dsp::FusionMethod::kJoint, dsp::FusionMethod::kPaper}) {
       for (int m = 0; m < kModes; ++m) {
@@ -835,8 +874,22 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
       den += data[r].w * e * e;
       excite = std::max(excite, std::abs(data[r].theta(ax)));
     }
-    if (excite >= kExciteFloorRad && den > 0.0 && num > 0.0) {
-      ap(ax) = round_sig(std::clamp(num / den, 1e-3, 100.0), 4);
+    if (excite >= kExciteFloorRad && den > 0.0) {
+      // The schema's upper bound; the lower one keeps the scale a scale (a sign flip or a
+      // thousandfold shrink only fits noise).
+      constexpr double kLo = 1e-3, kHi = 100.0;
+      const double wanted = num / den;
+      if (!(wanted >= kLo && wanted <= kHi)) {
+        std::vector<Driver> d;
+        for (std::size_t r = 0; r < n; ++r) {
+          const double e = run_of(r, true).rot_integral(ax);
+          if (std::abs(data[r].theta(ax)) >= kExciteFloorRad && e != 0.0)
+            d.push_back({sources[r]->info().name, data[r].theta(ax) / e});
+        }
+        rep.problems.push_back(
+            bound_problem(std::string("paper rotation_scale ") + "xyz"[ax], wanted, kLo, kHi, d));
+      }
+      ap(ax) = round_sig(std::clamp(wanted, kLo, kHi), 4);
     } else {
       rep.notes.push_back(std::string("paper fusion: no rotation about ") + "xyz"[ax] +
                           " in the recordings; its scale stays 1");
@@ -864,12 +917,20 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
         num += e * truth_p[r](ax);
         den += e * e;
       }
-      if (den > 0.0 && num > 0.0) {
+      if (den > 0.0) {
+        // A translation scale far from 1 only fits noise: the pipeline reads translation in
+        // metres from the pixel pitch.
+        constexpr double kLo = 0.2, kHi = 5.0;
         const double v = num / den;
-        st[static_cast<std::size_t>(ax)] = round_sig(std::clamp(v, 0.2, 5.0), 4);
-        if (st[static_cast<std::size_t>(ax)] != round_sig(v, 4)) {
-          rep.notes.push_back(std::string(what) + " translation scale " + "xy"[ax] +
-                              " hit its sanity bound 0.2 .. 5");
+        st[static_cast<std::size_t>(ax)] = round_sig(std::clamp(v, kLo, kHi), 4);
+        if (!(v >= kLo && v <= kHi)) {
+          std::vector<Driver> d;
+          for (std::size_t r = 0; r < n; ++r) {
+            const double e = translation_run(r, paper).final_pose.p(ax);
+            if (std::abs(truth_p[r](ax)) >= 1e-3 && e != 0.0)
+              d.push_back({sources[r]->info().name, truth_p[r](ax) / e});
+          }
+          rep.problems.push_back(bound_problem(std::string(what) + " " + "xy"[ax], v, kLo, kHi, d));
         }
       } else {
         rep.notes.push_back(std::string(what) + ": no translation along " + "xy"[ax] +
@@ -878,8 +939,8 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     }
     return st;
   };
-  const auto st_joint = fit_translation(false, "joint fusion");
-  const auto st_paper = fit_translation(true, "paper fusion");
+  const auto st_joint = fit_translation(false, "translation_scale");
+  const auto st_paper = fit_translation(true, "paper translation_scale");
   for (std::size_t k = 0; k < 2; ++k) {
     fitted.sensor[k].translation_scale = st_joint;
     fitted.paper[k].rotation_scale = {ap(0), ap(1), ap(2)};
@@ -906,6 +967,24 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     return "internal error: " + s.message();
   }
   rep.calibration = fitted;
+  // Coverage: the axes from the truth, the regime from the proxy that explains the recording.
+  rep.motions.resize(n);
+  for (std::size_t r = 0; r < n; ++r) {
+    rep.motions[r] = motion_from_truth(sources[r]->info());
+    rep.motions[r].set(fit.p.mode[r] == 0 ? Motion::kSlide : Motion::kStick);
+    if (rep.recordings[r].noise_sigma >= 0.0) rep.motions[r].set(Motion::kPadsOpen);
+  }
+  if (std::string m = coverage_message(missing_motions(rep.motions, true)); !m.empty()) {
+    rep.problems.push_back(m);
+  }
+  log("stage 4/4: self-check: the fitted calibration replayed as tacse3-replay would");
+  if (std::string e = check_calibration(sources, fitted, opt.jobs, opt.progress, &rep.check);
+      !e.empty()) {
+    return e;
+  }
+  for (const auto& c : rep.check.recordings) {
+    if (!c.passed()) rep.problems.push_back("not explained: " + c.name + ": " + c.reason());
+  }
   *report = std::move(rep);
   return {};
 }
@@ -914,10 +993,12 @@ std::string format_report(const CalibrateReport& rep) {
   std::string o;
   char line[512];
   const dsp::Calibration& c = rep.calibration.sensor[0];
+  int noisy = 0;
+  for (const auto& r : rep.recordings) noisy += r.noise_sigma >= 0.0 ? 1 : 0;
   std::snprintf(line, sizeof(line),
-                "contact threshold: f^z noise sigma %.4g -> contact_tau_on %.4g, contact_tau_off "
-                "%.4g\n",
-                rep.fz_noise_sigma, c.contact_tau_on, c.contact_tau_off);
+                "contact threshold: f^z noise sigma %.4g before contact (median of %d "
+                "recording(s)) -> contact_tau_on %.4g, contact_tau_off %.4g\n",
+                rep.fz_noise_sigma, noisy, c.contact_tau_on, c.contact_tau_off);
   o += line;
   std::snprintf(line, sizeof(line),
                 "shear gains (d, r, k) = (%.4g, %.4g, %.4g); c_velocity %.4g m/s per unit "
@@ -940,9 +1021,9 @@ std::string format_report(const CalibrateReport& rep) {
                 p.translation_scale[0], p.translation_scale[1]);
   o += line;
   o += "fit quality (final rotation error, deg; joint fusion measured, paper predicted):\n";
-  std::snprintf(line, sizeof(line), "  %-32s %7s %6s %7s %-12s %7s %7s %7s %7s %8s\n", "recording",
-                "truth", "sim", "persist", "explained by", "before", "after", "other", "paper",
-                "trans mm");
+  std::snprintf(line, sizeof(line), "  %-32s %7s %6s %8s %7s %-12s %7s %7s %7s %7s %8s\n",
+                "recording", "truth", "sim", "f^z sd", "persist", "explained by", "before", "after",
+                "other", "paper", "trans mm");
   o += line;
   for (const auto& r : rep.recordings) {
     std::string name = r.name;
@@ -950,14 +1031,17 @@ std::string format_report(const CalibrateReport& rep) {
     char persist[16] = "-";
     if (r.rest_persistence >= 0.0)
       std::snprintf(persist, sizeof(persist), "%.2f", r.rest_persistence);
-    std::snprintf(line, sizeof(line), "  %-32s %7.2f %6s %7s %-12s %7.2f %7.2f %7.2f %7.2f %8.2f\n",
-                  name.c_str(), r.truth_rotation_deg.norm(),
-                  r.sim_regime.empty() ? "-" : r.sim_regime.c_str(), persist,
-                  to_string(r.explained_by), r.before_deg, r.after_deg, r.after_other_deg,
-                  r.after_paper_deg, r.translation_after_mm);
+    char sd[16] = "-";
+    if (r.noise_sigma >= 0.0) std::snprintf(sd, sizeof(sd), "%.5f", r.noise_sigma);
+    std::snprintf(line, sizeof(line),
+                  "  %-32s %7.2f %6s %8s %7s %-12s %7.2f %7.2f %7.2f %7.2f %8.2f\n", name.c_str(),
+                  r.truth_rotation_deg.norm(), r.sim_regime.empty() ? "-" : r.sim_regime.c_str(),
+                  sd, persist, to_string(r.explained_by), r.before_deg, r.after_deg,
+                  r.after_other_deg, r.after_paper_deg, r.translation_after_mm);
     o += line;
   }
   for (const auto& n : rep.notes) o += "note: " + n + "\n";
+  if (!rep.check.recordings.empty()) o += format_check(rep.check);
   return o;
 }
 
