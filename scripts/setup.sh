@@ -23,8 +23,9 @@ PACKAGES=(
   # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks,
   # help2man for the manual pages made from each program's --help
   libsystemd-dev dpkg-dev file help2man
-  # unit, sysusers and networkd checks of the packaging tests (systemd-analyze verify)
-  systemd
+  # unit, sysusers and networkd checks of the packaging tests (systemd-analyze verify, security);
+  # libseccomp runs the daemon under the unit's system-call filter
+  systemd libseccomp-dev
   # fuzzing (libFuzzer and sanitizer runtimes for clang)
   libclang-rt-14-dev
   # the Python package (python/): python-can; its wheel is built offline with Debian's pip,

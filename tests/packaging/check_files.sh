@@ -52,6 +52,12 @@ LimitRTPRIO=99
 LimitMEMLOCK=infinity
 RestrictAddressFamilies=AF_CAN AF_UNIX AF_NETLINK
 DevicePolicy=closed
+SystemCallFilter=@system-service
+SystemCallFilter=~@privileged
+IPAddressDeny=any
+ProtectProc=invisible
+ProcSubset=pid
+UMask=0077
 StateDirectory=tacse3
 WantedBy=multi-user.target
 EOF
@@ -62,7 +68,15 @@ EOF
   grep -q "^Environment=TACSE3_BOARD=$board TACSE3_CALIBRATION=$cal$" "$PKG/tacse3d.service" ||
     fail "tacse3d.service Environment= defaults differ from tacse3d.conf (board '$board', calibration '$cal')"
   [ -f "$SRC/boards/$board/board.toml" ] || fail "tacse3d.conf: default board '$board' has no boards/$board/board.toml"
-  echo "unit: systemd-analyze verify clean; $n required settings present; default board $board"
+  # The exposure figure systemd-analyze gives the unit as shipped (0 = fully locked, 10 = none).
+  local exposure
+  out=$(cd "$TMP/unit" && systemd-analyze security --offline=true --no-pager ./tacse3d.service 2>&1) ||
+    fail "systemd-analyze security: $out"
+  exposure=$(sed -n 's/.*Overall exposure level for tacse3d.service: \([0-9.]*\).*/\1/p' <<<"$out")
+  [ -n "$exposure" ] || fail "systemd-analyze security printed no exposure level: $out"
+  awk -v e="$exposure" 'BEGIN { exit !(e <= 2.0) }' ||
+    fail "systemd-analyze security rates tacse3d.service $exposure, above 2.0: $(grep '✗' <<<"$out")"
+  echo "unit: systemd-analyze verify clean; exposure $exposure (<= 2.0); $n required settings present; default board $board"
 }
 
 # systemd-sysusers into an empty root: tacse3 exists, is in video and gpio, and gpio is created.
