@@ -12,7 +12,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <initializer_list>
 #include <limits>
 #include <optional>
@@ -20,6 +19,7 @@
 #include <system_error>
 
 #include "tacse3/config/toml_names.hpp"
+#include "tacse3/fileio/file_io.hpp"
 
 namespace tacse3::config {
 
@@ -315,6 +315,10 @@ void read_gpio_line(Reader& rd, const toml::table& parent, const char* key, Gpio
 
 bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* out,
                 std::string* error) {
+  if (std::string bad = check_toml_characters(text, origin); !bad.empty()) {
+    *error = std::move(bad);
+    return false;
+  }
   toml::parse_result parsed = toml::parse(text, origin);
   if (!parsed) {
     const auto& b = parsed.error().source().begin;
@@ -476,15 +480,27 @@ bool parse_board(std::string_view text, const std::string& origin, BoardConfig* 
 
 bool load_board(const std::filesystem::path& file, BoardConfig* out, std::string* error) noexcept {
   try {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) {
-      *error = file.string() + ": cannot open the board file: " +
-               std::error_code(errno, std::generic_category()).message();
-      return false;
+    std::string text;
+    const fileio::ReadResult r = fileio::read_regular_file(file, kMaxBoardBytes, &text);
+    const std::string name = file.string();
+    switch (r.error) {
+      case fileio::ReadError::kNone:
+        return parse_board(text, name, out, error);
+      case fileio::ReadError::kNotFound:
+        *error = name + ": board file not found";
+        break;
+      case fileio::ReadError::kNotRegular:
+        *error = name + ": is " + r.kind + ", expected a board file (a regular file)";
+        break;
+      case fileio::ReadError::kTooLarge:
+        *error = name + ": file is larger than " + fileio::size_text(kMaxBoardBytes) +
+                 "; not a board file";
+        break;
+      default:
+        *error = name + ": cannot read the board file" + fileio::os_error(r.os_errno);
+        break;
     }
-    std::ostringstream s;
-    s << in.rdbuf();
-    return parse_board(s.str(), file.string(), out, error);
+    return false;
   } catch (const std::exception& e) {
     *error = file.string() + ": " + e.what();
     return false;
@@ -501,7 +517,8 @@ std::filesystem::path resolve_board(const std::string& name_or_path,
       name_or_path.find('/') != std::string::npos ||
       (name_or_path.size() > 5 && name_or_path.compare(name_or_path.size() - 5, 5, ".toml") == 0);
   if (looks_like_path || fs::is_regular_file(name_or_path, ec)) {
-    if (fs::is_regular_file(name_or_path, ec)) return fs::path(name_or_path);
+    // Anything at the path goes to load_board, which says what it is if not a board file.
+    if (fs::exists(fs::symlink_status(name_or_path, ec))) return fs::path(name_or_path);
     *error = name_or_path + ": board file not found";
     return {};
   }

@@ -14,6 +14,7 @@
 #define TOML_ASSERT(expr) static_assert(true)
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -283,6 +284,9 @@ const toml::table* sub_table(const toml::table& root, std::string_view key,
 }
 
 Status parse_impl(std::string_view text, const std::string& origin, CalibrationSet* out) {
+  if (std::string bad = check_toml_characters(text, origin); !bad.empty()) {
+    return Status::error(std::move(bad));
+  }
   toml::parse_result parsed = toml::parse(text, origin);
   if (!parsed) {
     const toml::parse_error& e = parsed.error();
@@ -655,6 +659,94 @@ Status save_calibration(const std::filesystem::path& file, const CalibrationSet&
   } catch (...) {
     return Status::error(file.string() + ": unexpected error while writing");
   }
+}
+
+namespace {
+
+// The lexical state of TOML text that decides where non-ASCII bytes may stand.
+class TomlCharacterScan {
+ public:
+  explicit TomlCharacterScan(std::string_view text) : t_(text) {}
+
+  // Index of the first byte toml++ must not see, or npos.
+  std::size_t first_bad() {
+    while (i_ < t_.size()) {
+      const bool bad = state_ == State::kPlain ? plain() : in_string();
+      if (bad) return i_;
+    }
+    return std::string_view::npos;
+  }
+
+ private:
+  enum class State { kPlain, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
+
+  bool starts(std::string_view s) const { return t_.substr(i_, s.size()) == s; }
+  static bool ascii(char c) { return static_cast<unsigned char>(c) < 0x80; }
+
+  bool plain() {
+    const char c = t_[i_];
+    if (!ascii(c)) return true;
+    if (c == '#') {
+      const std::size_t end = t_.find('\n', i_);
+      i_ = end == std::string_view::npos ? t_.size() : end;
+    } else if (starts("\"\"\"") || starts("'''")) {
+      state_ = c == '"' ? State::kMultiBasic : State::kMultiLiteral;
+      i_ += 3;
+    } else {
+      if (c == '"') state_ = State::kBasic;
+      if (c == '\'') state_ = State::kLiteral;
+      ++i_;
+    }
+    return false;
+  }
+
+  bool in_string() {
+    const char c = t_[i_];
+    if ((state_ == State::kBasic || state_ == State::kLiteral) && c == '\n') {
+      state_ = State::kPlain;  // an unterminated string: toml++ reports it
+    } else if ((state_ == State::kBasic && c == '"') || (state_ == State::kLiteral && c == '\'')) {
+      state_ = State::kPlain;
+    } else if ((state_ == State::kMultiBasic && starts("\"\"\"")) ||
+               (state_ == State::kMultiLiteral && starts("'''"))) {
+      state_ = State::kPlain;
+      i_ += 2;
+    } else if (c == '\\' && (state_ == State::kBasic || state_ == State::kMultiBasic)) {
+      if (state_ == State::kMultiBasic && line_ending_backslash()) return !ascii(t_[i_]);
+      ++i_;  // the escaped character
+    }
+    ++i_;
+    return false;
+  }
+
+  // At a backslash in a multi-line basic string: if only whitespace follows it on its line, moves
+  // to the first character after the whitespace and newlines that follow (toml++ tests that
+  // one for whitespace) and returns true.
+  bool line_ending_backslash() {
+    std::size_t j = i_ + 1;
+    while (j < t_.size() && (t_[j] == ' ' || t_[j] == '\t' || t_[j] == '\r')) ++j;
+    if (j >= t_.size() || t_[j] != '\n') return false;
+    while (j < t_.size() && (t_[j] == ' ' || t_[j] == '\t' || t_[j] == '\r' || t_[j] == '\n')) ++j;
+    i_ = j < t_.size() ? j : t_.size() - 1;
+    return true;
+  }
+
+  std::string_view t_;
+  std::size_t i_ = 0;
+  State state_ = State::kPlain;
+};
+
+}  // namespace
+
+std::string check_toml_characters(std::string_view text, const std::string& origin) {
+  const std::size_t bad = TomlCharacterScan(text).first_bad();
+  if (bad == std::string_view::npos) return {};
+  const std::size_t line_start = text.rfind('\n', bad);
+  const std::size_t line =
+      1 + static_cast<std::size_t>(
+              std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(bad), '\n'));
+  const std::size_t column = line_start == std::string_view::npos ? bad + 1 : bad - line_start;
+  return origin + ":" + std::to_string(line) + ":" + std::to_string(column) +
+         ": TOML syntax error: a non-ASCII character outside a string or comment";
 }
 
 std::string type_name(const toml::node& n) {

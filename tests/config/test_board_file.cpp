@@ -2,6 +2,7 @@
 // config tests: board files (the shipped ones and bad ones) and their resolution by name.
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -208,5 +209,57 @@ TEST(Board, ResolvesNamesInTheDocumentedOrder) {
   EXPECT_NE(e.find("/etc/tacse3/boards/nope/board.toml"), std::string::npos) << e;
   EXPECT_TRUE(resolve_board("./missing.toml", "", "", &e).empty());
   unsetenv("TACSE3_BOARD_DIR");
+  fs::remove_all(dir);
+}
+
+// toml++ 3.3 reaches an "unreachable" branch (undefined behaviour; the sanitizer build aborts)
+// on a non-ASCII character where it tests for whitespace; such text is refused before it.
+TEST(Board, NonAsciiOutsideStringsIsRefusedBeforeToml) {
+  const std::string key = error_of("version = 1\n\xc3\xa9 = 1\n");
+  EXPECT_NE(key.find("test.toml:2:1: TOML syntax error: a non-ASCII character outside a string"),
+            std::string::npos)
+      << key;
+  const std::string after = error_of("version = 1 \xc2\xa7\n");
+  EXPECT_NE(after.find("test.toml:1:13:"), std::string::npos) << after;
+  // After a line-ending backslash in a multi-line string toml++ tests the next line's first
+  // character for whitespace too.
+  const std::string ml = error_of("version = 1\nname = \"\"\"\\\n  \xc2\xa7\"\"\"\n");
+  EXPECT_NE(ml.find("test.toml:3:3:"), std::string::npos) << ml;
+  // Strings and comments may hold any UTF-8, as TOML allows.
+  BoardConfig b;
+  std::string e;
+  EXPECT_TRUE(parse_board(
+      std::string("# caf\xc3\xa9 \xef\xbb\xbe\n") + kMinimal + "\n[sim]\nobject = \"sphere\"\n",
+      "test.toml", &b, &e))
+      << e;
+  EXPECT_TRUE(parse_board(std::string("name = \"Cam\xc3\xa9ra \\\" \xc2\xa7\"\n") + kMinimal,
+                          "test.toml", &b, &e))
+      << e;
+  EXPECT_EQ(b.name, "Cam\xc3\xa9ra \" \xc2\xa7");
+}
+
+// A board path that is not a regular file is named as what it is, read not at all (a FIFO would
+// block, /dev/zero never ends), and a file over 1 MiB is refused before it is read.
+TEST(Board, LoadRefusesWhatIsNotABoardFile) {
+  const fs::path dir = scratch_dir();
+  ASSERT_EQ(mkfifo((dir / "fifo").c_str(), 0600), 0);
+  {
+    std::ofstream big(dir / "big.toml");
+    big << std::string(kMaxBoardBytes + 1, '#');
+  }
+  BoardConfig b;
+  std::string e;
+  EXPECT_FALSE(load_board(dir / "fifo", &b, &e));
+  EXPECT_EQ(e, (dir / "fifo").string() + ": is a FIFO, expected a board file (a regular file)");
+  EXPECT_FALSE(load_board(dir, &b, &e));
+  EXPECT_NE(e.find("is a directory, expected a board file"), std::string::npos) << e;
+  EXPECT_FALSE(load_board("/dev/zero", &b, &e));
+  EXPECT_NE(e.find("/dev/zero: is a character device"), std::string::npos) << e;
+  EXPECT_FALSE(load_board(dir / "big.toml", &b, &e));
+  EXPECT_NE(e.find("larger than 1 MiB; not a board file"), std::string::npos) << e;
+  EXPECT_FALSE(load_board(dir / "absent.toml", &b, &e));
+  EXPECT_NE(e.find("absent.toml: board file not found"), std::string::npos) << e;
+  // resolve_board passes a path that exists on, so the message above is the one users see.
+  EXPECT_EQ(resolve_board((dir / "fifo").string(), "", "", &e), dir / "fifo");
   fs::remove_all(dir);
 }

@@ -507,3 +507,11 @@ TEST(SimCalibration, InstalledCopyFirstThenTheSourceTree) {
 }
 
 }  // namespace
+// The calibration reader refuses, before toml++ sees it, the text that reaches undefined
+// behaviour in toml++ 3.3 (the same check as the board reader; tests/config/test_board_file.cpp).
+TEST(CalibrationFile, NonAsciiOutsideStringsIsRefusedBeforeToml) {
+  expect_error(kHead + "[left]\n\xef\xbb\xbe = 1\n",
+               {"cal.toml:4:1: TOML syntax error: a non-ASCII character outside a string"});
+  cfg::CalibrationSet set;
+  EXPECT_TRUE(parse("# \xc2\xb1 0.5 \xc2\xb0\n" + kHead, &set).ok());
+}

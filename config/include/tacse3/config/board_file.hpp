@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -126,6 +127,9 @@ struct BoardConfig {
 // wrong types and out-of-range values are errors; missing optional tables take the defaults.
 bool parse_board(std::string_view text, const std::string& origin, BoardConfig* out,
                  std::string* error) noexcept;
+// Reads and parses a file (see parse_board). Only a regular file of at most kMaxBoardBytes is
+// read: a directory, FIFO or device is an error at once, named as such.
+inline constexpr std::size_t kMaxBoardBytes = std::size_t{1} << 20;
 bool load_board(const std::filesystem::path& file, BoardConfig* out, std::string* error) noexcept;
 
 // Resolves --board NAME|PATH (contract A): a path to an existing file (or anything containing a

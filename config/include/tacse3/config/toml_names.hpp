@@ -5,11 +5,19 @@
 #include <toml++/toml.h>
 
 #include <string>
+#include <string_view>
 
 namespace tacse3::config {
 
 // "a string", "an integer", "a float", ... : the type a TOML value has, for "got ..." messages.
 // Needs toml++ on the include path (the callers parse TOML themselves).
 std::string type_name(const toml::node& n);
+
+// Checks what toml++ 3.3 (Debian 12) must not see: a non-ASCII character outside a string or
+// comment, and one starting the line after a line-ending backslash in a multi-line string, reach
+// undefined behaviour (an "unreachable" branch) in its whitespace test. TOML allows non-ASCII
+// only in strings and comments, so nothing valid is refused. Returns "" or
+// "ORIGIN:LINE:COLUMN: message".
+std::string check_toml_characters(std::string_view text, const std::string& origin);
 
 }  // namespace tacse3::config
