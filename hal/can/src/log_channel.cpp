@@ -2,7 +2,10 @@
 // tacse3 hal/can: candump -L log channel.
 #include "tacse3/hal/can/log_channel.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -19,6 +22,40 @@ std::uint64_t realtime_us() {
          static_cast<std::uint64_t>(ts.tv_nsec) / 1000u;
 }
 
+// Opens a log to read: a regular file, or a FIFO (a live candump piped in, like stdin). A
+// directory or a device is refused at once: /dev/zero would be read forever. O_NONBLOCK so the
+// check comes before any wait; a FIFO then waits for its writer like a plain open would.
+std::FILE* open_input(const std::string& path, std::string& error) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    error = "cannot open log '" + path + "': " + std::strerror(errno);
+    return nullptr;
+  }
+  struct stat st {};
+  const char* kind = nullptr;
+  if (::fstat(fd, &st) != 0) {
+    kind = "unreadable";
+  } else if (S_ISDIR(st.st_mode)) {
+    kind = "a directory";
+  } else if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) {
+    kind = "a device";
+  } else if (S_ISSOCK(st.st_mode)) {
+    kind = "a socket";
+  }
+  if (kind != nullptr) {
+    error = "log '" + path + "' is " + kind + ", expected a candump -L log file (or - for stdin)";
+    ::close(fd);
+    return nullptr;
+  }
+  if (S_ISFIFO(st.st_mode)) ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  std::FILE* in = ::fdopen(fd, "r");
+  if (in == nullptr) {
+    error = "cannot open log '" + path + "': " + std::strerror(errno);
+    ::close(fd);
+  }
+  return in;
+}
+
 }  // namespace
 
 std::unique_ptr<LogChannel> LogChannel::open(const std::string& input_path,
@@ -30,11 +67,8 @@ std::unique_ptr<LogChannel> LogChannel::open(const std::string& input_path,
   if (input_path == "-") {
     in = stdin;
   } else if (!input_path.empty()) {
-    in = std::fopen(input_path.c_str(), "r");
-    if (in == nullptr) {
-      error = "cannot open log '" + input_path + "': " + std::strerror(errno);
-      return nullptr;
-    }
+    in = open_input(input_path, error);
+    if (in == nullptr) return nullptr;
     own_in = true;
   }
   if (output_path == "-") {
@@ -50,6 +84,7 @@ std::unique_ptr<LogChannel> LogChannel::open(const std::string& input_path,
   }
   auto ch = std::make_unique<LogChannel>(in, out, std::move(iface_name));
   ch->own_in_ = own_in;
+  if (own_in) ch->in_name_ = "'" + input_path + "'";
   ch->own_out_ = own_out;
   if (!output_path.empty()) ch->out_name_ = output_path == "-" ? "standard output" : output_path;
   return ch;
@@ -141,7 +176,7 @@ RxResult LogChannel::receive(RxFrame& out, int /*timeout_ms*/) {
     return RxResult::kFrame;
   }
   if (std::ferror(in_) != 0) {
-    error_ = std::string("reading the log failed: ") + std::strerror(errno);
+    error_ = "reading the log " + in_name_ + " failed: " + std::strerror(errno);
     return RxResult::kError;
   }
   return RxResult::kEnd;

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // tacse3 hal/can: the log channel round trip and the SocketCAN failure message.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <string>
@@ -58,6 +61,30 @@ TEST(LogChannel, ReportsMissingFiles) {
   EXPECT_FALSE(none.send(tp::CanFrame{}));
   can::RxFrame rx;
   EXPECT_EQ(none.receive(rx, 0), can::RxResult::kEnd);
+}
+
+// An input log that is a directory or a device is refused at open, naming the path: /dev/zero
+// would otherwise be read forever (no newline, no end). A FIFO is a live log and is accepted.
+TEST(LogChannel, RefusesDirectoriesAndDevicesAsInput) {
+  std::string error;
+  EXPECT_EQ(can::LogChannel::open("/dev/zero", "", error), nullptr);
+  EXPECT_EQ(error, "log '/dev/zero' is a device, expected a candump -L log file (or - for stdin)");
+  EXPECT_EQ(can::LogChannel::open("/", "", error), nullptr);
+  EXPECT_NE(error.find("log '/' is a directory"), std::string::npos) << error;
+  const std::string fifo = testing::TempDir() + "tacse3-log-fifo-" + std::to_string(::getpid());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const int writer =
+      ::open(fifo.c_str(), O_RDWR);  // keeps the FIFO open: the reader's open returns
+  ASSERT_GE(writer, 0);
+  const char line[] = "(1.000000) can0 021#D202964900005948\n";
+  ASSERT_EQ(::write(writer, line, sizeof line - 1), static_cast<ssize_t>(sizeof line - 1));
+  auto ch = can::LogChannel::open(fifo, "", error);
+  ASSERT_NE(ch, nullptr) << error;
+  can::RxFrame rx;
+  EXPECT_EQ(ch->receive(rx, 0), can::RxResult::kFrame);
+  EXPECT_EQ(rx.frame.id, 0x021u);
+  ::close(writer);
+  ::unlink(fifo.c_str());
 }
 
 // /dev/full fails every write with ENOSPC, as a full disk does: the first failure is kept with the

@@ -19,6 +19,7 @@ namespace tacse3::hal::can {
 class LogChannel final : public Channel {
  public:
   // "-" means stdin (input) / stdout (output); an empty path means "none". nullptr on failure.
+  // An input path must be a regular file or a FIFO (a directory or device is refused).
   static std::unique_ptr<LogChannel> open(const std::string& input_path,
                                           const std::string& output_path, std::string& error,
                                           std::string iface_name = "can0");
@@ -53,7 +54,8 @@ class LogChannel final : public Channel {
   bool own_in_ = false;
   bool own_out_ = false;
   std::string iface_;
-  std::string out_name_ = "the output";  // for messages: the path, or "standard output"
+  std::string in_name_ = "(standard input)";  // for messages: the quoted path
+  std::string out_name_ = "the output";       // for messages: the path, or "standard output"
   std::string error_;
   std::string write_error_;  // set once, before write_failed_
   std::atomic<bool> write_failed_{false};
