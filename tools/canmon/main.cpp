@@ -40,7 +40,8 @@ int main(int argc, char** argv) {
   double bitrate = 500000.0, data_bitrate = 2000000.0, duration_s = 0.0;
   auto* src = app.add_option_group("source");
   src->add_option("--iface", iface, "SocketCAN interface, e.g. can0");
-  src->add_option("--log", log_path, "candump -L log file, - for stdin");
+  src->add_option("--log", log_path, "candump -L log file, - for stdin")
+      ->check(tacse3::tools::non_empty_path());
   src->require_option(1);
   app.add_option("--node", node, "Only this node id (default: every node)")
       ->check(CLI::Range(0, 63));

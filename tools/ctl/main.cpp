@@ -88,11 +88,14 @@ int main(int argc, char** argv) {
   auto* dst = app.add_option_group("destination");
   dst->add_option("--iface", iface, "SocketCAN interface, e.g. can0");
   dst->add_option("--socket", socket_path,
-                  "Unix socket of a tacse3d started with --can-socket PATH (host without CAN)");
-  dst->add_option("--log-out", log_out, "Write the command as a candump -L line (file or -)");
+                  "Unix socket of a tacse3d started with --can-socket PATH (host without CAN)")
+      ->check(tacse3::tools::non_empty_path());
+  dst->add_option("--log-out", log_out, "Write the command as a candump -L line (file or -)")
+      ->check(tacse3::tools::non_empty_path());
   dst->require_option(1);
   app.add_option("--ack-from", ack_from,
-                 "With --log-out: read the gripper's reply from this candump -L log (or -)");
+                 "With --log-out: read the gripper's reply from this candump -L log (or -)")
+      ->check(tacse3::tools::non_empty_path());
   app.add_option("--node", node, "Node id of the gripper")
       ->check(CLI::Range(1u, 63u))
       ->capture_default_str();

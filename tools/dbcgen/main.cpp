@@ -3,10 +3,10 @@
 // Python package) from the message table.
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <string>
 
+#include "tacse3/fileio/file_io.hpp"
 #include "tacse3/protocol_dbc/dbc_writer.hpp"
 #include "tacse3/protocol_dbc/table_json.hpp"
 #include "tacse3/tools/cli.hpp"
@@ -31,7 +31,9 @@ int main(int argc, char** argv) {
                  "dbc, or json: the node-independent message table (python/src/tacse3)")
       ->check(CLI::IsMember({"dbc", "json"}))
       ->capture_default_str();
-  app.add_option("-o,--output", output, "Output file, - for stdout")->capture_default_str();
+  app.add_option("-o,--output", output, "Output file, - for stdout")
+      ->check(tacse3::tools::non_empty_path())
+      ->capture_default_str();
   if (const int rc = tacse3::tools::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   tacse3::protocol::dbc::DbcOptions opt;
@@ -59,10 +61,10 @@ int main(int argc, char** argv) {
     std::cout << dbc;
     return std::cout.good() ? 0 : 1;
   }
-  std::ofstream f(output, std::ios::binary);
-  f << dbc;
-  if (!f.good()) {
-    std::cerr << "tacse3-dbcgen: cannot write " << output << '\n';
+  // Atomically: a full disk or a killed run leaves the old file or none, never a part.
+  std::string error;
+  if (!tacse3::fileio::write_file_atomically(output, dbc, &error)) {
+    std::cerr << "tacse3-dbcgen: " << error << '\n';
     return 1;
   }
   return 0;

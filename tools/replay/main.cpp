@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/tools/can_log.hpp"
@@ -51,6 +52,19 @@ void print_tracking(std::FILE* report, const tt::TrackingError& t) {
                t.frames, t.rotation_rms_deg, t.rotation_max_deg, t.rotation_lag_s * 1e3,
                t.translation_rms_mm, t.translation_max_mm, t.translation_lag_s * 1e3);
 }
+
+// An output file that run() created is removed unless the run completed: a recording that fails
+// half way (a corrupt PNG, a full disk) leaves no partial CSV behind.
+struct RemoveUnlessKept {
+  explicit RemoveUnlessKept(std::string p) : path(std::move(p)) {}
+  ~RemoveUnlessKept() {
+    if (!keep && !path.empty()) std::remove(path.c_str());
+  }
+  RemoveUnlessKept(const RemoveUnlessKept&) = delete;
+  RemoveUnlessKept& operator=(const RemoveUnlessKept&) = delete;
+  std::string path;
+  bool keep = false;
+};
 
 int run(int argc, char** argv) {
   CLI::App app{
@@ -121,6 +135,7 @@ int run(int argc, char** argv) {
   const bool to_stdout = out_file == "-";
   std::FILE* csv = to_stdout ? stdout : std::fopen(out_file.c_str(), "w");
   if (csv == nullptr) return fail(out_file + ": cannot open for writing");
+  RemoveUnlessKept csv_guard(to_stdout ? "" : out_file);
   std::FILE* report = to_stdout ? stderr : stdout;
 
   tt::FieldDumper dumper;
@@ -140,9 +155,11 @@ int run(int argc, char** argv) {
     sinks.can = &can;
   }
   std::FILE* slip = nullptr;
+  RemoveUnlessKept slip_guard("");
   if (!slip_log.empty()) {
     slip = std::fopen(slip_log.c_str(), "w");
     if (slip == nullptr) return fail(slip_log + ": cannot open for writing");
+    slip_guard.path = slip_log;
     std::fprintf(slip,
                  "t_ns,sensor,contact,slipping,onset,stick_confirmed,relax_rate_per_s,shift_m,"
                  "rate_m_s,load_drop_per_s,releasing,anchor_set,velocity_anchored,points,"
@@ -177,6 +194,8 @@ int run(int argc, char** argv) {
   if (sinks.can != nullptr) {
     if (err = can.close(); !err.empty()) return fail(err);
   }
+  csv_guard.keep = true;
+  slip_guard.keep = true;
   if (quiet) return 0;
 
   const tt::RunSummary sum = tt::summarize(info, run.frames, opt.sensors);
