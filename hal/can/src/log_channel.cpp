@@ -80,6 +80,9 @@ std::unique_ptr<LogChannel> LogChannel::open(const std::string& input_path,
       if (own_in) std::fclose(in);
       return nullptr;
     }
+    // Unbuffered: send() writes each line at once, and after a failed write no buffered rest
+    // can reach the file when it is closed.
+    std::setvbuf(out, nullptr, _IONBF, 0);
     own_out = true;
   }
   auto ch = std::make_unique<LogChannel>(in, out, std::move(iface_name));
@@ -87,6 +90,7 @@ std::unique_ptr<LogChannel> LogChannel::open(const std::string& input_path,
   if (own_in) ch->in_name_ = "'" + input_path + "'";
   ch->own_out_ = own_out;
   if (!output_path.empty()) ch->out_name_ = output_path == "-" ? "standard output" : output_path;
+  if (own_out) ch->line_end_ = 0;
   return ch;
 }
 
@@ -133,12 +137,15 @@ bool LogChannel::send(const CanFrame& f) {
   }
   if (std::fwrite(line, 1, n + 1, out_) != n + 1 || std::fflush(out_) != 0) {
     const int e = errno;
+    // A full disk took part of the line: cut a file back to its last whole line.
+    if (line_end_ >= 0) (void)::ftruncate(::fileno(out_), line_end_);
     error_ = "CAN log " + out_name_ + ": write failed: " + std::strerror(e);
     write_error_ = error_;
     write_failed_.store(true, std::memory_order_release);
     tx_errors_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
+  if (own_out_) line_end_ = ::ftello(out_);  // -1 for a FIFO: nothing to cut
   tx_frames_.fetch_add(1, std::memory_order_relaxed);
   return true;
 }

@@ -2,9 +2,12 @@
 // tacse3 hal/can: the log channel round trip and the SocketCAN failure message.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <cstdio>
 #include <string>
 
@@ -115,4 +118,51 @@ TEST(SocketCan, FailsWithAClearError) {
   error.clear();
   EXPECT_EQ(can::SocketCanChannel::open("", can::SocketCanOptions{}, error), nullptr);
   EXPECT_FALSE(error.empty());
+}
+
+// A full disk, simulated with RLIMIT_FSIZE (writes past the limit fail with EFBIG once SIGXFSZ is
+// ignored) in a child process: the log stops with the error and ends at a whole line, every line
+// of it a candump line.
+TEST(LogChannel, FullDiskLeavesWholeLines) {
+  const std::string path = testing::TempDir() + "tacse3-log-full-" + std::to_string(::getpid());
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit lim{1000, 1000};
+    if (::setrlimit(RLIMIT_FSIZE, &lim) != 0) ::_exit(3);
+    std::string error;
+    auto ch = can::LogChannel::open("", path, error);
+    if (ch == nullptr) ::_exit(4);
+    tp::CanFrame f{};
+    f.id = 0x021;
+    f.len = 8;
+    for (int i = 0; i < 100; ++i) {
+      if (!ch->send(f)) break;
+    }
+    const bool stopped = ch->write_failed() && ch->write_error().find(path) != std::string::npos;
+    ::_exit(stopped ? 0 : 5);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "3 setrlimit, 4 open, 5 no write error reported";
+  std::string text(2000, '\0');
+  std::FILE* in = std::fopen(path.c_str(), "rb");
+  ASSERT_NE(in, nullptr);
+  text.resize(std::fread(text.data(), 1, text.size(), in));
+  std::fclose(in);
+  ::unlink(path.c_str());
+  ASSERT_GT(text.size(), 500u);
+  EXPECT_LE(text.size(), 1000u);
+  EXPECT_EQ(text.back(), '\n');
+  std::size_t lines = 0;
+  for (std::size_t at = 0; at < text.size(); ++lines) {
+    const std::size_t end = text.find('\n', at);
+    tp::LogRecord r;
+    EXPECT_EQ(tp::parse_candump_line(std::string_view(text).substr(at, end - at), r),
+              tp::Status::kOk);
+    at = end + 1;
+  }
+  EXPECT_GT(lines, 10u);
 }

@@ -43,7 +43,8 @@ class LogChannel final : public Channel {
   std::uint64_t skipped_frames() const { return skipped_; }  // error / remote frames
 
   // The first write error of the output ("CAN log FILE: write failed: CAUSE"). After it, send()
-  // writes nothing more: a log cut mid-line is worse than one that stops at a line's end. Safe to
+  // writes nothing more: a log cut mid-line is worse than one that stops at a line's end (an
+  // output file opened here is cut back to its last whole line, e.g. after a full disk). Safe to
   // call from another thread than send()'s.
   bool write_failed() const noexcept { return write_failed_.load(std::memory_order_acquire); }
   const std::string& write_error() const noexcept { return write_error_; }
@@ -54,6 +55,7 @@ class LogChannel final : public Channel {
   bool own_in_ = false;
   bool own_out_ = false;
   std::string iface_;
+  long long line_end_ = -1;  // an opened output file's size up to its last whole line
   std::string in_name_ = "(standard input)";  // for messages: the quoted path
   std::string out_name_ = "the output";       // for messages: the path, or "standard output"
   std::string error_;
