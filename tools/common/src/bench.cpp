@@ -3,6 +3,7 @@
 // engine (and, on request, the double-precision reference pipeline in lock step).
 #include "tacse3/tools/bench.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -47,6 +48,30 @@ std::string SimCase::sim_arguments() const {
     s += buf;
   }
   return s;
+}
+
+std::string parse_profile_list(const std::string& text, std::vector<std::string>* out) {
+  const std::vector<std::string> known = {"reference"};
+  out->clear();
+  if (text == "all") {
+    *out = known;
+    return {};
+  }
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string name = text.substr(start, end - start);
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      return "unknown profile \"" + name + "\" (tacse3-sim --profile list)";
+    }
+    out->push_back(name);
+    start = end + 1;
+  }
+  return {};
+}
+
+bool profile_is_stress(const std::string& profile, double friction) {
+  return profile == "reference" && friction < 1.5;
 }
 
 std::string make_sim_config(const SimCase& c, sim::SimConfig* out) {

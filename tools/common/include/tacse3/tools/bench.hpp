@@ -17,9 +17,10 @@ namespace tacse3::tools {
 
 // One simulated recording, described like a tacse3-sim command line.
 struct SimCase {
-  std::string object = "sphere";  // preset name (tacse3-sim --object)
-  std::string motion = "rz";      // rx, ry, rz, tx, ty
-  double magnitude = 30.0;        // deg or mm
+  std::string profile = "reference";  // sensor profile (tacse3-sim --profile)
+  std::string object = "sphere";      // preset name (tacse3-sim --object)
+  std::string motion = "rz";          // rx, ry, rz, tx, ty
+  double magnitude = 30.0;            // deg or mm
   std::uint64_t seed = 1;
   double radius_mm = 0.0;  // 0 = the preset's size
   double indentation_mm = 1.0;
@@ -31,6 +32,14 @@ struct SimCase {
   // The equivalent tacse3-sim options (for docs and messages).
   std::string sim_arguments() const;
 };
+
+// "all", a name, or a comma-separated list of names → the profiles, in the simulator's order
+// for "all". Error text names the unknown profile.
+std::string parse_profile_list(const std::string& text, std::vector<std::string>* out);
+
+// A stress profile's shear cannot carry the speed of a large slide (its friction caps it):
+// reported without a goal (docs/accuracy.md). `friction` > 0 overrides the presets' friction.
+bool profile_is_stress(const std::string& profile, double friction);
 
 // The simulator configuration tacse3-sim would use for the case (both sensors).
 std::string make_sim_config(const SimCase& c, sim::SimConfig* out);
