@@ -47,6 +47,9 @@ TEST(BenchReport, GoalsTakeTheWorstRowAndTheObjectMean) {
     rows.push_back(row("rz", 30, e, -1.0));
     rows.back().vd = true;
   }
+  rows.push_back(row("rx", 60, 30.0, 30.0));  // capped: shown, not counted
+  rows.back().vb = true;
+  rows.back().carried = false;
   rows.push_back(row("tx", 0.4, 0.125, -1.0));
   rows.back().stick = true;
   const ba::GoalValues g = ba::measure_goals(rows);

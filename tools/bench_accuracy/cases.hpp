@@ -20,6 +20,9 @@ struct Row {
   double paper_vc_single_drift = kNaN, paper_vc_single_trans = kNaN;
   double paper_vc_dual_drift = kNaN, paper_vc_dual_trans = kNaN;
   std::string vd_object;  // Table V-D row name
+  // The shear can show the motion at every instant (tools::shear_carries_speed); rows where it
+  // cannot are reported without counting towards the rotation goals.
+  bool carried = true;
   double paper_vd = kNaN;
   std::vector<tools::EvalConfig> configs;
   std::vector<tools::EvalResult> results;

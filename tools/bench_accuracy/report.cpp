@@ -71,9 +71,9 @@ void table_vb(const std::vector<Row>& rows, std::string* o) {
   for (const auto& r : rows) {
     if (!r.vb) continue;
     const auto& j = r.res(r.slot.dual_joint);
-    std::snprintf(line, sizeof(line), "| %s | %g | %s | %s | %s | %s | %s |\n", r.c.motion.c_str(),
-                  r.c.magnitude, fmt(r.paper_vb, 1).c_str(),
-                  fmt(j.errors.final_rotation_error_deg).c_str(),
+    std::snprintf(line, sizeof(line), "| %s | %g%s | %s | %s | %s | %s | %s |\n",
+                  r.c.motion.c_str(), r.c.magnitude, r.carried ? "" : " (capped)",
+                  fmt(r.paper_vb, 1).c_str(), fmt(j.errors.final_rotation_error_deg).c_str(),
                   fmt(r.res(r.slot.dual_paper).errors.final_rotation_error_deg).c_str(),
                   tracking_cell(j.tracking).c_str(), ref_cell(j).c_str());
     *o += line;
@@ -115,9 +115,9 @@ void table_vd(const std::vector<Row>& rows, std::string* o) {
   for (const auto& r : rows) {
     if (!r.vd) continue;
     const auto& j = r.res(r.slot.dual_joint);
-    std::snprintf(line, sizeof(line), "| %s | %s %s | %s | %s | %s | %s |\n", r.vd_object.c_str(),
-                  r.c.object.c_str(), r.c.motion.c_str(), fmt(r.paper_vd, 1).c_str(),
-                  fmt(j.errors.final_rotation_error_deg).c_str(),
+    std::snprintf(line, sizeof(line), "| %s | %s %s%s | %s | %s | %s | %s |\n", r.vd_object.c_str(),
+                  r.c.object.c_str(), r.c.motion.c_str(), r.carried ? "" : " (capped)",
+                  fmt(r.paper_vd, 1).c_str(), fmt(j.errors.final_rotation_error_deg).c_str(),
                   fmt(r.res(r.slot.dual_paper).errors.final_rotation_error_deg).c_str(),
                   tracking_cell(j.tracking).c_str());
     *o += line;
@@ -179,13 +179,14 @@ GoalValues measure_goals(const std::vector<Row>& rows) {
   for (const auto& r : rows) {
     const tools::EvalResult& e = r.res(r.slot.dual_joint);
     const double rot = e.errors.final_rotation_error_deg;
-    if (r.vb && e.tracking.valid) worst(&g.v[0], e.tracking.rotation_rms_deg);
-    if (r.vb) worst(&g.v[r.c.magnitude <= 30 ? 1 : (r.c.magnitude <= 60 ? 2 : 3)], rot);
+    if (r.vb && r.carried && e.tracking.valid) worst(&g.v[0], e.tracking.rotation_rms_deg);
+    if (r.vb && r.carried)
+      worst(&g.v[r.c.magnitude <= 30 ? 1 : (r.c.magnitude <= 60 ? 2 : 3)], rot);
     if (r.vc && !r.rotation()) {
       worst(&g.v[4], rot);
       worst(&g.v[5], e.errors.final_translation_error_mm);
     }
-    if (r.vd) {
+    if (r.vd && r.carried) {
       vd_sum += rot;
       ++vd_n;
       worst(&g.v[7], rot);

@@ -7,9 +7,11 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 
 #include "tacse3/dsp_ref/pipeline_ref.hpp"
+#include "tacse3/sim/profile.hpp"
 #include "tacse3/tools/locked_reference.hpp"
 #include "tacse3/tools/sim_source.hpp"
 
@@ -26,12 +28,19 @@ std::string SimCase::sim_arguments() const {
   std::snprintf(buf, sizeof(buf), "--object %s --motion %s --magnitude %g --seed %llu",
                 object.c_str(), motion.c_str(), magnitude, static_cast<unsigned long long>(seed));
   std::string s = buf;
+  double nominal_indentation = 1.0;
+  if (profile != "reference") {
+    s += " --profile " + profile;
+    sim::SensorProfile p;
+    std::string e;
+    if (sim::make_profile(profile, seed, &p, &e)) nominal_indentation = p.indentation_mm;
+  }
   if (radius_mm > 0.0) {
     std::snprintf(buf, sizeof(buf), " --radius %g", radius_mm);
     s += buf;
   }
   if (indentation_mm != 1.0) {
-    std::snprintf(buf, sizeof(buf), " --indentation %g", indentation_mm);
+    std::snprintf(buf, sizeof(buf), " --indentation %g", indentation_mm * nominal_indentation);
     s += buf;
   }
   if (friction > 0.0) {
@@ -51,7 +60,13 @@ std::string SimCase::sim_arguments() const {
 }
 
 std::string parse_profile_list(const std::string& text, std::vector<std::string>* out) {
-  const std::vector<std::string> known = {"reference"};
+  std::vector<std::string> known;
+  const std::string names = sim::profile_names();
+  for (std::size_t start = 0; start < names.size();) {
+    const std::size_t end = std::min(names.find(", ", start), names.size());
+    known.push_back(names.substr(start, end - start));
+    start = end + 2;
+  }
   out->clear();
   if (text == "all") {
     *out = known;
@@ -62,7 +77,7 @@ std::string parse_profile_list(const std::string& text, std::vector<std::string>
     const std::size_t end = std::min(text.find(',', start), text.size());
     const std::string name = text.substr(start, end - start);
     if (std::find(known.begin(), known.end(), name) == known.end()) {
-      return "unknown profile \"" + name + "\" (tacse3-sim --profile list)";
+      return "unknown profile \"" + name + "\" (one of: " + names + ", or all)";
     }
     out->push_back(name);
     start = end + 1;
@@ -70,8 +85,24 @@ std::string parse_profile_list(const std::string& text, std::vector<std::string>
   return {};
 }
 
-bool profile_is_stress(const std::string& profile, double friction) {
-  return profile == "reference" && friction < 1.5;
+bool shear_carries_speed(const SimCase& c) {
+  sim::SimConfig cfg;
+  if (!make_sim_config(c, &cfg).empty()) return false;
+  // Only an in-plane rotation drags the deepest contact point across the gel; a torsion's
+  // deepest point stays put and a translation is read from the mask centroid, not the shear.
+  if (cfg.scenario.axis != sim::MotionAxis::kRx && cfg.scenario.axis != sim::MotionAxis::kRy) {
+    return true;
+  }
+  // Peak surface speed at the deepest point: the minimum-jerk profile's peak rate, 15/8 of the
+  // mean, on the lever of the object's surface on the grasp axis (its size). The slide law holds
+  // the shear at the cap mu kappa d, which reads as a speed of mu kappa d / c
+  // (docs/simulator.md, tangential response; tools/analysis/friction_cap_bound.py).
+  const sim::Scenario scn(cfg.scenario);
+  const double angle = std::abs(cfg.scenario.magnitude) * M_PI / 180.0;
+  const double peak = 1.875 * angle / scn.motion_duration_s() * cfg.scenario.object.size_mm;
+  const double cap = cfg.scenario.object.friction * cfg.gel.shear_compliance *
+                     cfg.scenario.indentation_mm / cfg.gel.drag_time_s;
+  return peak <= cap;
 }
 
 std::string make_sim_config(const SimCase& c, sim::SimConfig* out) {
@@ -83,7 +114,10 @@ std::string make_sim_config(const SimCase& c, sim::SimConfig* out) {
   }
   if (!sim::parse_axis(c.motion, &cfg.scenario.axis)) return "unknown motion \"" + c.motion + "\"";
   cfg.scenario.magnitude = c.magnitude;
-  cfg.scenario.indentation_mm = c.indentation_mm;
+  sim::SensorProfile profile;
+  if (std::string e; !sim::make_profile(c.profile, c.seed, &profile, &e)) return e;
+  sim::apply_profile(profile, &cfg);
+  cfg.scenario.indentation_mm = c.indentation_mm * profile.indentation_mm;
   cfg.scenario.approach_s = c.approach_s;
   cfg.scenario.grasp_s = c.grasp_s;
   cfg.scenario.settle_s = c.settle_s;

@@ -23,6 +23,8 @@ struct SimCase {
   double magnitude = 30.0;            // deg or mm
   std::uint64_t seed = 1;
   double radius_mm = 0.0;  // 0 = the preset's size
+  // Indentation relative to the profile's nominal one (mm for a profile pressing 1 mm, as the
+  // reference does).
   double indentation_mm = 1.0;
   double friction = 0.0;  // object-gel friction (tacse3-sim --friction); 0 = the preset's
   double hold_s = 0.4;    // hold after the motion
@@ -37,9 +39,11 @@ struct SimCase {
 // for "all". Error text names the unknown profile.
 std::string parse_profile_list(const std::string& text, std::vector<std::string>* out);
 
-// A stress profile's shear cannot carry the speed of a large slide (its friction caps it):
-// reported without a goal (docs/accuracy.md). `friction` > 0 overrides the presets' friction.
-bool profile_is_stress(const std::string& profile, double friction);
+// Whether the gel's shear can show the case's motion at every instant: false for an in-plane
+// rotation whose peak surface speed at the deepest contact point exceeds the slide law's cap
+// speed mu kappa d / c, beyond which the motion leaves no trace in the shear
+// (docs/accuracy.md, stress rows). Always true for torsions and translations.
+bool shear_carries_speed(const SimCase& c);
 
 // The simulator configuration tacse3-sim would use for the case (both sensors).
 std::string make_sim_config(const SimCase& c, sim::SimConfig* out);
