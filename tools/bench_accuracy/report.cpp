@@ -240,6 +240,9 @@ std::string goal_matrix(const std::vector<ProfileOutcome>& outcomes, double fail
     const char* met = std::isnan(w) ? "–" : (w <= goal.limit ? "yes" : "**no**");
     o += " " + fmt(w) + " | " + met + " |\n";
   }
+  o += "| problems the calibration self-check reports | 0 |";
+  for (const auto& p : outcomes) o += " " + std::to_string(p.calibration_problems) + " |";
+  o += " | |\n";
   return o;
 }
 
