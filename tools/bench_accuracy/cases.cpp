@@ -145,19 +145,18 @@ void finish_rows(const std::string& profile, bool reference, std::vector<Row>* r
 
 std::vector<SimCase> calibration_set(bool quick, const std::string& profile) {
   // Different seeds, radii and indentations from the test rows.
-  std::vector<SimCase> c = {
-      mk("sphere", "rx", 30, 7, 18, 0.8), mk("sphere", "rz", 30, 7, 18, 0.8),
-      mk("sphere", "tx", 10, 7, 18, 0.8), mk("sphere", "rz", 3, 7, 18, 0.8),
-      mk("sphere", "ry", 2, 7, 18, 0.8),  mk("sphere", "tx", 0.3, 7, 18, 0.8)};
+  std::vector<SimCase> c = {mk("sphere", "rx", 30, 7, 18, 0.8), mk("sphere", "rz", 30, 7, 18, 0.8),
+                            mk("sphere", "tx", 10, 7, 18, 0.8), mk("sphere", "rz", 3, 7, 18, 0.8),
+                            mk("sphere", "ry", 2, 7, 18, 0.8),  mk("sphere", "tx", 0.3, 7, 18, 0.8),
+                            mk("sphere", "ty", 10, 7, 18, 0.8)};
   if (!quick) {
     for (const auto& x : {mk("sphere", "ry", 30, 8, 22, 1.2), mk("sphere", "rz", 60, 8, 22, 1.2),
                           mk("sphere", "ty", 10, 8, 22, 1.2), mk("sphere", "rx", 3, 8, 22, 1.2),
                           mk("sphere", "rx", 30, 8, 22, 1.2), mk("sphere", "tx", 10, 8, 22, 1.2),
-                          mk("sphere", "ry", 30, 7, 18, 0.8), mk("sphere", "ty", 10, 7, 18, 0.8),
-                          mk("sphere", "rx", 3, 7, 18, 0.8), mk("sphere", "ty", 0.5, 7, 18, 0.8),
-                          mk("sphere", "ry", 2, 8, 22, 1.2), mk("sphere", "tx", 0.3, 8, 22, 1.2),
-                          mk("sphere", "ty", 0.5, 8, 22, 1.2), mk("ellipsoid", "rz", 30, 9),
-                          mk("cube", "rz", 2, 9)}) {
+                          mk("sphere", "ry", 30, 7, 18, 0.8), mk("sphere", "rx", 3, 7, 18, 0.8),
+                          mk("sphere", "ty", 0.5, 7, 18, 0.8), mk("sphere", "ry", 2, 8, 22, 1.2),
+                          mk("sphere", "tx", 0.3, 8, 22, 1.2), mk("sphere", "ty", 0.5, 8, 22, 1.2),
+                          mk("ellipsoid", "rz", 30, 9), mk("cube", "rz", 2, 9)}) {
       c.push_back(x);
     }
   }
