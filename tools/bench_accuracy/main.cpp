@@ -132,6 +132,7 @@ ProfileRun run_profile(const std::string& profile, const Options& opt) {
   }
   const auto t2 = std::chrono::steady_clock::now();
   run.outcome.goals = ba::measure_goals(rows);
+  run.outcome.calibration_problems = problems;
   char line[256];
   std::snprintf(line, sizeof(line), "Calibration %.0f s, evaluation of %zu recordings %.0f s.\n\n",
                 std::chrono::duration<double>(t1 - t0).count(), rows.size(),
