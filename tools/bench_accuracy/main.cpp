@@ -29,6 +29,7 @@ struct Options {
   bool quick = false;
   int jobs = 2;
   std::string markdown, cal_out, cal_in, profile = "reference";
+  tacse3::config::CalibrationSet loaded;  // --calibration, read before any run
   double friction = 0.0;
   bool cross = false;
   double fail_above = 0.0;
@@ -72,7 +73,7 @@ std::string profile_calibration(const std::string& profile, const Options& opt,
                                 tacse3::config::CalibrationSet* cal, std::string* report,
                                 std::size_t* problems) {
   if (!opt.cal_in.empty()) {
-    if (auto s = tacse3::config::load_calibration(opt.cal_in, cal); !s) return s.message();
+    *cal = opt.loaded;
     return {};
   }
   std::vector<tt::SimCase> cases = ba::calibration_set(opt.quick, profile);
@@ -249,6 +250,13 @@ int run(int argc, char** argv) {
     std::string e;
     if (!out->empty() && !tacse3::fileio::check_output_file(*out, &e)) {
       std::fprintf(stderr, "%s: error: %s\n", kProg, e.c_str());
+      return 1;
+    }
+  }
+  // A --calibration that cannot be read is the user's to fix before minutes of simulation.
+  if (!opt.cal_in.empty()) {
+    if (auto s = tacse3::config::load_calibration(opt.cal_in, &opt.loaded); !s) {
+      std::fprintf(stderr, "%s: error: %s\n", kProg, s.message().c_str());
       return 1;
     }
   }
