@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include "tacse3/tools/metrics.hpp"
@@ -82,6 +83,35 @@ TEST(Tracking, TheMotionStartsAtTwoPercentOfItsLargestExcursion) {
   std::vector<rec::TruthSample> still = truth();
   for (auto& s : still) s = still.front();
   EXPECT_EQ(tt::motion_start_ns(still), 0);
+}
+
+// A robot's logged pose carries noise (0.05 mm, 0.01 deg per sample): on a 3 deg turn with no
+// translation, 2 % of the noisy translation's largest excursion is below the noise itself, so
+// only the noise bar keeps the first noisy row from starting the motion.
+TEST(Tracking, ALoggedPosesNoiseDoesNotStartTheMotion) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> mm(0.0, 0.05), deg(0.0, 0.01);
+  std::vector<rec::TruthSample> noisy;
+  for (int i = 0; i < kFrames; ++i) {
+    const double t = static_cast<double>(t_of(i)) * 1e-9;
+    const Eigen::Vector3d axis(deg(rng), deg(rng), 3.0 * std::clamp(t - 0.5, 0.0, 1.0) + deg(rng));
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(axis.norm() * kDeg, axis.normalized()));
+    rec::TruthSample s;
+    s.t_ns = t_of(i);
+    s.qw = q.w();
+    s.qx = q.x();
+    s.qy = q.y();
+    s.qz = q.z();
+    s.px = mm(rng) * 1e-3;
+    s.py = mm(rng) * 1e-3;
+    s.pz = mm(rng) * 1e-3;
+    noisy.push_back(s);
+  }
+  // Noiseless, 2 % of 3 deg is reached at 0.52 s (frame 63); the noise bar (about 0.11 deg)
+  // moves it to about 0.537 s. Frame 1 is what the bar prevents.
+  const std::int64_t start = tt::motion_start_ns(noisy);
+  EXPECT_GE(start, t_of(kStart - 2));
+  EXPECT_LE(start, t_of(kStart + 8));
 }
 
 TEST(Tracking, AnEstimateLateByWholeFramesTracksAtThatLag) {

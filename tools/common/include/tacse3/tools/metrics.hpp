@@ -65,9 +65,10 @@ struct TrackingError {
 };
 
 // When the truth starts to move: the first row whose rotation from the first row reaches 2 % of
-// the largest over the table (at least 0.05 deg), or whose translation reaches 2 % of the largest
-// (at least 0.02 mm), so a real rig's pose noise does not start it. The first row's time when the
-// truth never moves that far.
+// the largest over the table, or whose translation reaches 2 % of the largest; at least 0.05 deg
+// and 0.02 mm, and at least 8 sigma of the truth's own noise (from its second differences), so
+// a real rig's pose noise does not start it. The first row's time when the truth never moves
+// that far.
 std::int64_t motion_start_ns(const std::vector<recording::TruthSample>& truth);
 
 TrackingError tracking_error(const std::vector<dsp::Pose>& estimate,
