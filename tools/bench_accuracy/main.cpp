@@ -18,6 +18,7 @@
 #include "tacse3/tools/bench.hpp"
 #include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/progress.hpp"
+#include "text.hpp"
 
 namespace {
 
@@ -111,7 +112,7 @@ ProfileRun run_profile(const std::string& profile, const Options& opt) {
   if (std::string e = profile_calibration(profile, opt, &run.cal, &cal_report, &problems);
       !e.empty()) {
     run.outcome.error = "calibration failed";
-    run.tables = "### Profile " + profile + "\n\nCalibration failed: " + e + "\n";
+    run.tables = ba::cat({"### Profile ", profile, "\n\nCalibration failed: ", e, "\n"});
     std::fprintf(stderr, "%s: %s: calibration failed: %s\n", kProg, profile.c_str(), e.c_str());
     return run;
   }
@@ -128,7 +129,7 @@ ProfileRun run_profile(const std::string& profile, const Options& opt) {
                rows.size());
   if (std::string e = evaluate_rows(&rows, run.cal, opt, profile); !e.empty()) {
     run.outcome.error = "evaluation failed";
-    run.tables = "### Profile " + profile + "\n\nEvaluation failed: " + e + "\n";
+    run.tables = ba::cat({"### Profile ", profile, "\n\nEvaluation failed: ", e, "\n"});
     return run;
   }
   const auto t2 = std::chrono::steady_clock::now();
@@ -138,10 +139,10 @@ ProfileRun run_profile(const std::string& profile, const Options& opt) {
   std::snprintf(line, sizeof(line), "Calibration %.0f s, evaluation of %zu recordings %.0f s.\n\n",
                 std::chrono::duration<double>(t1 - t0).count(), rows.size(),
                 std::chrono::duration<double>(t2 - t1).count());
-  run.tables = "### Profile " + profile + (run.outcome.stress ? " (stress: no goal)" : "") +
-               "\n\n" + line + ba::profile_tables(rows);
+  run.tables = ba::cat({"### Profile ", profile, run.outcome.stress ? " (stress: no goal)" : "",
+                        "\n\n", line, ba::profile_tables(rows)});
   if (!cal_report.empty()) {
-    run.tables += "\n#### Calibration fit\n\n```\n" + cal_report + "```\n";
+    ba::append(&run.tables, {"\n#### Calibration fit\n\n```\n", cal_report, "```\n"});
   }
   return run;
 }
@@ -161,7 +162,7 @@ std::string run_cross(const std::vector<ProfileRun>& runs, const Options& opt) {
           r.c.friction = opt.friction;
           r.carried = tt::shear_carries_speed(r.c);
         }
-        const std::string label = names[i] + "→" + names[j];
+        const std::string label = ba::cat({names[i], "→", names[j]});
         if (std::string e = evaluate_rows(&rows, runs[i].cal, opt, label); e.empty()) {
           g = ba::measure_goals(rows);
         }
@@ -173,7 +174,7 @@ std::string run_cross(const std::vector<ProfileRun>& runs, const Options& opt) {
 }
 
 std::string header(const std::string& cmd, const Options& opt, double seconds) {
-  std::string o = "Command: `" + cmd + "`\n\n";
+  std::string o = ba::cat({"Command: `", cmd, "`\n\n"});
   char line[512];
   std::snprintf(
       line, sizeof(line),
@@ -197,7 +198,7 @@ std::string header(const std::string& cmd, const Options& opt, double seconds) {
 
 std::string join_command(int argc, char** argv) {
   std::string cmd;
-  for (int i = 0; i < argc; ++i) cmd += (i ? " " : "") + std::string(argv[i]);
+  for (int i = 0; i < argc; ++i) ba::append(&cmd, {i ? " " : "", argv[i]});
   return cmd;
 }
 
@@ -286,7 +287,7 @@ int run(int argc, char** argv) {
          "rows\n\n" +
          cross;
   }
-  for (const auto& r : runs) o += "\n" + r.tables;
+  for (const auto& r : runs) ba::append(&o, {"\n", r.tables});
   std::printf("%s", o.c_str());
   if (!opt.markdown.empty()) {
     if (std::string e; !tacse3::fileio::write_file_atomically(opt.markdown, o, &e)) {

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "text.hpp"
+
 namespace tacse3::bench_accuracy {
 
 const std::array<Goal, kGoalCount> kGoals = {{
@@ -165,8 +167,8 @@ void table_detector(const std::vector<Row>& rows, std::string* o) {
     const bool slide = e.slip.true_slip + e.slip.false_stick > 0;
     (slide ? slide_all : stick_all).merge(e.slip);
   }
-  *o += "| slide | " + slip_cells(slide_all) + " |\n";
-  *o += "| stick | " + slip_cells(stick_all) + " |\n";
+  append(o, {"| slide | ", slip_cells(slide_all), " |\n"});
+  append(o, {"| stick | ", slip_cells(stick_all), " |\n"});
 }
 
 }  // namespace
@@ -215,33 +217,34 @@ std::string goal_matrix(const std::vector<ProfileOutcome>& outcomes, double fail
   std::string o = "| goal | limit (stretch) |";
   std::string rule = "|---|---|";
   for (const auto& p : outcomes) {
-    o += " " + p.name + (p.stress ? " (stress)" : "") + " |";
+    append(&o, {" ", p.name, p.stress ? " (stress)" : "", " |"});
     rule += "---|";
   }
-  o += " worst | met |\n" + rule + "---|---|\n";
+  append(&o, {" worst | met |\n", rule, "---|---|\n"});
   for (const auto& p : outcomes) {
-    if (!p.error.empty()) failed->push_back(p.name + ": " + p.error);
+    if (!p.error.empty()) failed->push_back(cat({p.name, ": ", p.error}));
   }
   for (std::size_t k = 0; k < kGoalCount; ++k) {
     const Goal& goal = kGoals[k];
-    o += std::string("| ") + goal.what + " | ≤ " + fmt(goal.limit, 1) +
-         (std::isnan(goal.stretch) ? "" : " (" + fmt(goal.stretch, 1) + ")") + " |";
+    append(&o, {"| ", goal.what, " | ≤ ", fmt(goal.limit, 1),
+                std::isnan(goal.stretch) ? std::string() : cat({" (", fmt(goal.stretch, 1), ")"}),
+                " |"});
     double w = kNaN;
     for (const auto& p : outcomes) {
       const double v = p.error.empty() ? p.goals.v[k] : kNaN;
-      o += " " + (p.error.empty() ? fmt(v) : std::string("failed")) + " |";
+      append(&o, {" ", p.error.empty() ? fmt(v) : std::string("failed"), " |"});
       if (p.stress) continue;
       worst(&w, v);
       if (fail_factor > 0.0 && !std::isnan(v) && v > fail_factor * goal.limit) {
-        failed->push_back(p.name + ": " + goal.what + " " + fmt(v) + " > " + fmt(fail_factor, 1) +
-                          " × " + fmt(goal.limit, 1));
+        failed->push_back(cat({p.name, ": ", goal.what, " ", fmt(v), " > ", fmt(fail_factor, 1),
+                               " × ", fmt(goal.limit, 1)}));
       }
     }
     const char* met = std::isnan(w) ? "–" : (w <= goal.limit ? "yes" : "**no**");
-    o += " " + fmt(w) + " | " + met + " |\n";
+    append(&o, {" ", fmt(w), " | ", met, " |\n"});
   }
   o += "| problems the calibration self-check reports | 0 |";
-  for (const auto& p : outcomes) o += " " + std::to_string(p.calibration_problems) + " |";
+  for (const auto& p : outcomes) append(&o, {" ", std::to_string(p.calibration_problems), " |"});
   o += " | |\n";
   return o;
 }
@@ -251,15 +254,15 @@ std::string cross_matrix(const std::vector<std::string>& names,
   std::string o = "| calibrated on ↓ / evaluated on → |";
   std::string rule = "|---|";
   for (const auto& n : names) {
-    o += " " + n + " |";
+    append(&o, {" ", n, " |"});
     rule += "---|";
   }
-  o += "\n" + rule + "\n";
+  append(&o, {"\n", rule, "\n"});
   for (std::size_t i = 0; i < names.size(); ++i) {
-    o += "| " + names[i] + " |";
+    append(&o, {"| ", names[i], " |"});
     for (std::size_t j = 0; j < names.size(); ++j) {
       const GoalValues& g = cells[i][j];
-      o += " " + fmt(g.v[0]) + " / " + fmt(g.v[8]) + (i == j ? " (own)" : "") + " |";
+      append(&o, {" ", fmt(g.v[0]), " / ", fmt(g.v[8]), i == j ? " (own)" : "", " |"});
     }
     o += "\n";
   }

@@ -30,7 +30,7 @@ std::string SimCase::sim_arguments() const {
   std::string s = buf;
   double nominal_indentation = 1.0;
   if (profile != "reference") {
-    s += " --profile " + profile;
+    s.append(" --profile ").append(profile);
     sim::SensorProfile p;
     std::string e;
     if (sim::make_profile(profile, seed, &p, &e)) nominal_indentation = p.indentation_mm;
@@ -77,7 +77,9 @@ std::string parse_profile_list(const std::string& text, std::vector<std::string>
     const std::size_t end = std::min(text.find(',', start), text.size());
     const std::string name = text.substr(start, end - start);
     if (std::find(known.begin(), known.end(), name) == known.end()) {
-      return "unknown profile \"" + name + "\" (one of: " + names + ", or all)";
+      std::string e = "unknown profile \"";
+      e.append(name).append("\" (one of: ").append(names).append(", or all)");
+      return e;
     }
     out->push_back(name);
     start = end + 1;
