@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "bus_events.hpp"
+#include "run_cmd.hpp"
 #include "tacse3/hal/can/unix_channel.hpp"
 
 namespace fs = std::filesystem;
@@ -30,29 +31,9 @@ using namespace tacse3;
 
 namespace {
 
-struct RunResult {
-  int status = -1;
-  std::string out;
-};
-
-RunResult run_cmd(const std::string& cmd) {
-  RunResult r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.out.append(buf, n);
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
-
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using tacse3::test::read_all;
+using tacse3::test::run_cmd;
+using tacse3::test::RunResult;
 
 double angle_deg(const protocol::Quaternion& q) {
   return Eigen::Quaterniond(q.w, q.x, q.y, q.z)

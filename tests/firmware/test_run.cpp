@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "bus_events.hpp"
+#include "run_cmd.hpp"
 
 #if TACSE3_HAVE_RECORDER
 #include "tacse3/recording/recording.hpp"
@@ -39,29 +40,9 @@ std::string seconds(int s) {
   return std::to_string(s * kTimeScale);
 }
 
-struct RunResult {
-  int status = -1;
-  std::string out;
-};
-
-RunResult run_cmd(const std::string& cmd) {
-  RunResult r;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.out.append(buf, n);
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
-
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using tacse3::test::read_all;
+using tacse3::test::run_cmd;
+using tacse3::test::RunResult;
 
 // Sets `key = value` on the line that starts with `key = ` (the first one) in a board file.
 void set_key(std::string* text, const std::string& key, const std::string& value) {
