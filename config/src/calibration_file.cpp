@@ -676,6 +676,8 @@ class TomlCharacterScan {
     }
     return std::string_view::npos;
   }
+  // The bad byte follows a backslash in a basic string.
+  bool after_backslash() const { return escape_; }
 
  private:
   enum class State { kPlain, kBasic, kLiteral, kMultiBasic, kMultiLiteral };
@@ -712,6 +714,13 @@ class TomlCharacterScan {
       i_ += 2;
     } else if (c == '\\' && (state_ == State::kBasic || state_ == State::kMultiBasic)) {
       if (state_ == State::kMultiBasic && line_ending_backslash()) return !ascii(t_[i_]);
+      // toml++ tests the character after a backslash for whitespace too; every TOML escape
+      // is ASCII, so a non-ASCII one is refused here.
+      if (i_ + 1 < t_.size() && !ascii(t_[i_ + 1])) {
+        escape_ = true;
+        ++i_;
+        return true;
+      }
       ++i_;  // the escaped character
     }
     ++i_;
@@ -733,12 +742,14 @@ class TomlCharacterScan {
   std::string_view t_;
   std::size_t i_ = 0;
   State state_ = State::kPlain;
+  bool escape_ = false;
 };
 
 }  // namespace
 
 std::string check_toml_characters(std::string_view text, const std::string& origin) {
-  const std::size_t bad = TomlCharacterScan(text).first_bad();
+  TomlCharacterScan scan(text);
+  const std::size_t bad = scan.first_bad();
   if (bad == std::string_view::npos) return {};
   const std::size_t line_start = text.rfind('\n', bad);
   const std::size_t line =
@@ -746,7 +757,10 @@ std::string check_toml_characters(std::string_view text, const std::string& orig
               std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(bad), '\n'));
   const std::size_t column = line_start == std::string_view::npos ? bad + 1 : bad - line_start;
   return origin + ":" + std::to_string(line) + ":" + std::to_string(column) +
-         ": TOML syntax error: a non-ASCII character outside a string or comment";
+         (scan.after_backslash()
+              ? ": TOML syntax error: a non-ASCII character after a backslash (no "
+                "TOML escape starts with one)"
+              : ": TOML syntax error: a non-ASCII character outside a string or comment");
 }
 
 std::string type_name(const toml::node& n) {

@@ -225,6 +225,13 @@ TEST(Board, NonAsciiOutsideStringsIsRefusedBeforeToml) {
   // character for whitespace too.
   const std::string ml = error_of("version = 1\nname = \"\"\"\\\n  \xc2\xa7\"\"\"\n");
   EXPECT_NE(ml.find("test.toml:3:3:"), std::string::npos) << ml;
+  // So does a backslash followed directly by a non-ASCII character (fuzz_board found this one).
+  const std::string esc = error_of("name = \"\"\"\\\xc2\xa7\n\"\"\"\nv = 1\n");
+  EXPECT_NE(esc.find("test.toml:1:12: TOML syntax error: a non-ASCII character after a backslash"),
+            std::string::npos)
+      << esc;
+  const std::string esc1 = error_of("version = 1\nname = \"\\\xc3\xa9\"\n");
+  EXPECT_NE(esc1.find("test.toml:2:10:"), std::string::npos) << esc1;
   // Strings and comments may hold any UTF-8, as TOML allows.
   BoardConfig b;
   std::string e;
