@@ -319,3 +319,23 @@ loopback_pads() {
   grep -q 'Width/Height *: 320/240' "$TACSE3_OUT/video20-fmt.txt" || fail "loopback capture side is not 320x240"
   echo "ok: both loopback devices carry 320x240 frames"
 }
+
+# can_flap CYCLES: with tacse3d streaming on vcan0, takes vcan0 down and up CYCLES times. After each
+# up the daemon's next Timestamp frame (0x021, node 1) must arrive within 5 s, read by a fresh
+# candump, and the daemon must still run. Writes "cycles= resumed= resume_ms_median= resume_ms_max="
+# to $TACSE3_OUT/flap.txt (resume: from `ip link set up` returning to candump's first frame).
+can_flap() {
+  _n=$1; _k=0; : >/tmp/resume_ms
+  while [ "$_k" -lt "$_n" ]; do
+    ip link set vcan0 down || fail "cycle $_k: ip link set vcan0 down"
+    ip link set vcan0 up || fail "cycle $_k: ip link set vcan0 up"
+    _t0=$(uptime_ms)
+    timeout 5 candump -n 1 vcan0,021:7FF >/dev/null 2>&1 || fail "cycle $_k: no Timestamp frame within 5 s of vcan0 up"
+    echo $(($(uptime_ms) - _t0)) >>/tmp/resume_ms
+    kill -0 "$DAEMON_PID" 2>/dev/null || fail "cycle $_k: tacse3d exited: $(tail -3 "$TACSE3_OUT/daemon.log")"
+    _k=$((_k + 1))
+  done
+  _med=$(sort -n /tmp/resume_ms | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
+  _max=$(sort -n /tmp/resume_ms | tail -1)
+  echo "cycles=$_n resumed=$(wc -l </tmp/resume_ms) resume_ms_median=$_med resume_ms_max=$_max" | tee "$TACSE3_OUT/flap.txt"
+}
