@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# tacse3: build the arm64 and armhf .deb packages (cpack) and check each against tests/packaging/.
+# tacse3: build the arm64 and armhf .deb packages (cpack) and check each against tests/packaging/;
+# with each, the controller SDK packages tacse3-dev and libtacse3-protocol<soversion>
+# (scripts/package-sdk.sh), and those also for amd64 from a host Release build.
 #
-# Usage: scripts/package.sh [aarch64|armhf ...]       build + check (default: aarch64 armhf)
+# Usage: scripts/package.sh [aarch64|armhf|amd64 ...] build + check (default: all three; amd64 = the
+#                                                     SDK packages only)
 #        scripts/package.sh --check DEB ARCH          check one .deb (ARCH: arm64 | armhf)
 #        scripts/package.sh --expected ARCH           print the expected file list (kind path)
 # Builds in build/package-<preset> (TACSE3_PACKAGE_BUILD_ROOT to change build/), with the tests
-# and benchmarks off and only the packaged programs built; the .debs land in build/package-<preset>/deb.
+# and benchmarks off and only the packaged programs (amd64: the protocol libraries) built; the .debs
+# land in build/package-<preset>/deb.
 # The target sysroots must exist (scripts/make-sysroot.sh aarch64|armhf, done by scripts/setup.sh).
 # Exits non-zero with one line per problem when a package does not match.
 set -euo pipefail
@@ -164,31 +168,46 @@ case "${1:-}" in
     exit 0
     ;;
   -h | --help)
-    sed -n '3,12p' "$0"
+    sed -n '3,15p' "$0"
     exit 0
     ;;
 esac
 
-for tool in cmake cpack dpkg-deb file readelf help2man; do
+for tool in cmake cpack dpkg-deb dpkg-architecture file readelf help2man; do
   command -v "$tool" >/dev/null || die "$tool not found (scripts/setup.sh installs it)"
 done
 JOBS="${TACSE3_JOBS:-$(nproc)}"
 ROOT="${TACSE3_PACKAGE_BUILD_ROOT:-$SRC/build}"
 presets=("$@")
-if [ ${#presets[@]} -eq 0 ]; then presets=(aarch64 armhf); fi
+if [ ${#presets[@]} -eq 0 ]; then presets=(aarch64 armhf amd64); fi
 
 failed=0
 for preset in "${presets[@]}"; do
   case "$preset" in
     aarch64) arch=arm64 ;;
     armhf) arch=armhf ;;
-    *) die "unknown preset '$preset' (aarch64 | armhf)" ;;
+    amd64) arch=amd64 ;;
+    *) die "unknown preset '$preset' (aarch64 | armhf | amd64)" ;;
   esac
+  dir="$ROOT/package-$preset"
+  # The SDK's libraries go to the multiarch directory, so the packages of several architectures
+  # install side by side (Multi-Arch: same).
+  libdir="lib/$(dpkg-architecture -a "$arch" -qDEB_HOST_MULTIARCH 2>/dev/null)"
+  if [ "$preset" = amd64 ]; then
+    echo "=== [amd64] configure a host Release build (tests and benchmarks off) ==="
+    cmake -S "$SRC" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTACSE3_WERROR=ON \
+      -DTACSE3_BUILD_TESTS=OFF -DTACSE3_BUILD_BENCH=OFF "-DCMAKE_INSTALL_LIBDIR=$libdir" \
+      >"$dir.configure.log" 2>&1 || { cat "$dir.configure.log" >&2; die "[amd64] configure failed"; }
+    echo "=== [amd64] SDK packages ==="
+    rm -rf "$dir/deb"
+    "$SRC/scripts/package-sdk.sh" "$dir" amd64 || failed=1
+    continue
+  fi
   [ -d "$SRC/build/sysroot/$preset" ] ||
     die "no target sysroot build/sysroot/$preset: run scripts/make-sysroot.sh $preset"
-  dir="$ROOT/package-$preset"
   echo "=== [$preset] configure (tests and benchmarks off) ==="
-  cmake --preset "$preset" -B "$dir" -DTACSE3_BUILD_TESTS=OFF -DTACSE3_BUILD_BENCH=OFF >"$dir.configure.log" 2>&1 ||
+  cmake --preset "$preset" -B "$dir" -DTACSE3_BUILD_TESTS=OFF -DTACSE3_BUILD_BENCH=OFF \
+    "-DCMAKE_INSTALL_LIBDIR=$libdir" >"$dir.configure.log" 2>&1 ||
     { cat "$dir.configure.log" >&2; die "[$preset] configure failed"; }
   echo "=== [$preset] build the packaged programs ==="
   cmake --build "$dir" -j "$JOBS" --target tacse3_package_programs
@@ -202,6 +221,8 @@ for preset in "${presets[@]}"; do
     die "[$preset] cpack did not write $deb"
   fi
   check_deb "$deb" "$arch" || failed=1
+  echo "=== [$preset] SDK packages ==="
+  "$SRC/scripts/package-sdk.sh" "$dir" "$arch" || failed=1
 done
 if [ "$failed" != 0 ]; then die "package check failed (see the lines above)"; fi
 echo "package: all packages OK"

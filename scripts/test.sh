@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 # tacse3: the test command. Builds and runs the host tests, the ASan+UBSan build and the aarch64
 # build under qemu-user (the host presets include the Python package's tests), then builds and
-# checks the arm64/armhf .deb packages and the Python wheel and .deb, runs the bounded fuzzers of
+# checks the arm64/armhf .deb packages, the controller SDK .debs (amd64/arm64/armhf, with programs
+# built against them) and the Python wheel and .deb, runs the bounded fuzzers of
 # every input parser (fuzz/run.sh) and the real-driver VM suite (tests/vm: SocketCAN, V4L2,
 # libcamera, GPIO in
 # qemu-system guests). Exits non-zero on any failure.
@@ -25,10 +26,11 @@ for preset in "${presets[@]}"; do
   summary+=("$preset: ok")
 done
 
-# The arm64 and armhf .deb packages, built and checked against tests/packaging/contents.txt, and
+# The arm64 and armhf .deb packages, built and checked against tests/packaging/contents.txt, the
+# SDK packages (scripts/package-sdk.sh, tests/packaging/contents-sdk.txt and test_sdk.sh), and
 # the Python package's wheel and python3-tacse3 .deb (build/python-package).
 if [ "${TACSE3_SKIP_PACKAGE:-0}" != "1" ]; then
-  echo "=== .deb packages (arm64, armhf) ==="
+  echo "=== .deb packages (arm64, armhf; SDK also amd64) ==="
   scripts/package.sh
   echo "=== Python package (wheel, python3-tacse3 .deb) ==="
   scripts/package-python.sh

@@ -211,7 +211,8 @@ case_scripts() {
   done
   if command -v shellcheck >/dev/null; then
     shellcheck -s sh "$PKG"/deb/postinst "$PKG"/deb/prerm "$PKG"/deb/postrm || fail "shellcheck on the maintainer scripts"
-    shellcheck "$SRC/scripts/package.sh" "$SRC/scripts/make-sysroot.sh" "$0" || fail "shellcheck on the packaging scripts"
+    shellcheck "$SRC/scripts/package.sh" "$SRC/scripts/package-sdk.sh" "$SRC/scripts/make-sysroot.sh" "$0" \
+      "$SRC/tests/packaging/test_sdk.sh" "$SRC/tests/packaging/test_sdk_checker.sh" || fail "shellcheck on the packaging scripts"
   fi
   echo "scripts: postinst, prerm, postrm pass sh -n$(command -v shellcheck >/dev/null && echo ' and shellcheck')"
 }
