@@ -213,6 +213,9 @@ bool Engine::apply(const protocol::Command& c) noexcept {
       return true;
     case CommandCode::kQuery:
       return true;
+    case CommandCode::kStartRecording:  // recording_command()
+    case CommandCode::kStopRecording:
+      return false;
   }
   return false;
 }

@@ -41,7 +41,7 @@ static_assert(named(table::kStatus, 0, "State") && named(table::kStatus, 1, "Hea
               named(table::kStatus, 9, "VelocityMode") && named(table::kStatus, 10, "Confidence") &&
               named(table::kStatus, 11, "RateDivider") && named(table::kStatus, 12, "FaultCode") &&
               named(table::kStatus, 13, "RejectedCommands") &&
-              named(table::kStatus, 14, "Counter"));
+              named(table::kStatus, 14, "Calibrated") && named(table::kStatus, 15, "Counter"));
 static_assert(named(table::kStatusContact, 0, "AreaLeft") &&
               named(table::kStatusContact, 1, "AreaRight") &&
               named(table::kStatusContact, 2, "ConfidenceLeft") &&
@@ -61,9 +61,10 @@ static_assert(named(table::kCommand, 0, "CommandCode") && named(table::kCommand,
               named(table::kCommand, 4, "VelocityMode") &&
               named(table::kCommand, 5, "RateDivider") &&
               named(table::kCommand, 6, "StreamEnable") && named(table::kCommand, 7, "QueryItem") &&
-              named(table::kCommand, 8, "Sequence"));
+              named(table::kCommand, 8, "RecordingNumber") &&
+              named(table::kCommand, 9, "Sequence"));
 static_assert(named(table::kAck, 0, "AckCommand") && named(table::kAck, 1, "AckResult") &&
-              named(table::kAck, 9, "Sequence"));
+              named(table::kAck, 10, "Sequence"));
 
 constexpr std::size_t kCycleBlockBytes = 7;  // FD: bytes 35..62 stay reserved (0)
 
@@ -341,7 +342,8 @@ Status encode(const StatusMsg& m, const TxConfig& tx, CanFrame& out) noexcept {
   set(r, 11, m.rate_divider);
   set(r, 12, static_cast<std::int64_t>(m.fault));
   set(r, 13, m.rejected_commands);
-  set(r, 14, m.counter & 0x0F);
+  set_flag(r, 14, m.calibrated);
+  set(r, 15, m.counter & 0x0F);
   return encode_raw(MessageId::kStatus, r, tx, out);
 }
 
@@ -426,10 +428,15 @@ Status encode(const Command& c, const TxConfig& tx, CanFrame& out) noexcept {
       if (static_cast<std::int64_t>(c.query) > s[7].raw_max) return Status::kBadArgument;
       set(r, 7, static_cast<std::int64_t>(c.query));
       break;
+    case CommandCode::kStartRecording:
+      set(r, 8, c.recording_number);
+      break;
+    case CommandCode::kStopRecording:
+      break;
     default:
       return Status::kBadArgument;
   }
-  set(r, 8, c.sequence & 0x0F);
+  set(r, 9, c.sequence & 0x0F);
   return encode_raw(MessageId::kCommand, r, tx, out);
 }
 
@@ -569,7 +576,8 @@ Status decode(const CanFrame& f, const IdLayout& layout, Decoded& out) noexcept 
       m.rate_divider = static_cast<std::uint8_t>(r.value[11]);
       m.fault = static_cast<FaultCode>(r.value[12]);
       m.rejected_commands = static_cast<std::uint8_t>(r.value[13]);
-      m.counter = static_cast<std::uint8_t>(r.value[14]);
+      m.calibrated = r.value[14] != 0;
+      m.counter = static_cast<std::uint8_t>(r.value[15]);
       out.payload = m;
       return Status::kOk;
     }
@@ -618,7 +626,10 @@ Status decode(const CanFrame& f, const IdLayout& layout, Decoded& out) noexcept 
       if ((r.present & (1u << 5)) != 0) m.rate_divider = static_cast<std::uint8_t>(r.value[5]);
       if ((r.present & (1u << 6)) != 0) m.stream_enabled = r.value[6] != 0;
       if ((r.present & (1u << 7)) != 0) m.query = static_cast<QueryItem>(r.value[7]);
-      m.sequence = static_cast<std::uint8_t>(r.value[8]);
+      if ((r.present & (1u << 8)) != 0) {
+        m.recording_number = static_cast<std::uint16_t>(r.value[8]);
+      }
+      m.sequence = static_cast<std::uint8_t>(r.value[9]);
       std::memcpy(m.args.data(), d + 2, m.args.size());
       out.payload = m;
       return Status::kOk;

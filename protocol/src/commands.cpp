@@ -15,9 +15,11 @@ int argument_bytes(std::uint8_t code) noexcept {
   switch (static_cast<CommandCode>(code)) {
     case CommandCode::kTare:
     case CommandCode::kResetPose:
+    case CommandCode::kStopRecording:
       return 0;
     case CommandCode::kSetFingerSeparation:
     case CommandCode::kSetFusion:
+    case CommandCode::kStartRecording:
       return 2;
     case CommandCode::kSetRateDivider:
     case CommandCode::kSetStream:
@@ -98,6 +100,8 @@ CommandResult validate_command(const CanFrame& f, const Endpoint& self) noexcept
       break;
     case CommandCode::kTare:
     case CommandCode::kResetPose:
+    case CommandCode::kStartRecording:  // every uint16 is a recording number
+    case CommandCode::kStopRecording:
       break;
   }
   r.code = ok ? AckCode::kAck : AckCode::kOutOfRange;
@@ -147,6 +151,11 @@ CommandResult CommandReceiver::receive(const CanFrame& f) noexcept {
       break;
     case AckCode::kBusy:
     case AckCode::kInternalError:
+    case AckCode::kAlreadyRecording:
+    case AckCode::kNotRecording:
+    case AckCode::kNoRecordDir:
+    case AckCode::kRecordingExists:
+    case AckCode::kDiskError:
       break;
   }
   return r;

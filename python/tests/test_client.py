@@ -88,6 +88,20 @@ class ClientTest(unittest.TestCase):
         with self.assertRaisesRegex(tacse3.NackError, r"node 1 rejected TARE \(seq 0\): BUSY"):
             client.tare()
 
+    def test_recording_commands(self):
+        client, gripper = self.start()
+        ack = client.start_recording(42)
+        self.assertEqual((ack.command, ack.data), ("START_RECORDING", [42, 0, 0, 0]))
+        self.assertEqual(client.stop_recording().command, "STOP_RECORDING")
+        self.assertEqual([(c.command, c.arguments) for c in gripper.commands],
+                         [("START_RECORDING", {"RecordingNumber": 42}), ("STOP_RECORDING", {})])
+
+    def test_recording_nack_names_the_reason(self):
+        client, _ = self.start(answer=lambda c: tacse3.Ack(1, c.command, "RECORDING_EXISTS",
+                                                           c.sequence, c.args))
+        with self.assertRaisesRegex(tacse3.NackError, "START_RECORDING .*RECORDING_EXISTS"):
+            client.start_recording(3)
+
     def test_other_nodes_and_sequences_are_ignored(self):
         def before(cmd):
             stale = tacse3.Ack(1, cmd.command, "BUSY", (cmd.sequence - 1) & 15)

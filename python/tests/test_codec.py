@@ -78,6 +78,11 @@ class Golden(unittest.TestCase):
         self.assertEqual((s.confidence, s.rate_divider, s.fault, s.rejected_commands, s.counter),
                          (225 * 0.004, 2, "NONE", 3, 7))
         self.assertEqual(s.encode().data.hex(" ").upper(), "42 BB E1 02 00 03 70 72")
+        self.assertFalse(s.calibrated)
+        cal = tacse3.decode(frame(0x028, "42 BB E1 02 00 03 71 6F"))  # Calibrated: bit 48
+        self.assertTrue(cal.calibrated)
+        self.assertEqual((cal.state, cal.rejected_commands, cal.counter), ("TRACKING", 3, 7))
+        self.assertEqual(cal.encode().data.hex(" ").upper(), "42 BB E1 02 00 03 71 6F")
         c = tacse3.decode(frame(0x029, "D0 07 FF FF FA 7D 70 87"))
         self.assertEqual((c.area_left, c.area_right, c.confidence_left, c.confidence_right),
                          (2000 * 1e-7, None, 250 * 0.004, 125 * 0.004))
@@ -105,6 +110,16 @@ class Golden(unittest.TestCase):
         nack = tacse3.Ack(1, "SET_RATE_DIVIDER", "OUT_OF_RANGE", 9, [200, 0, 0, 0])
         self.assertEqual(tacse3.encode_ack(nack).data.hex(" ").upper(), "05 05 C8 00 00 00 90 A6")
         self.assertEqual(tacse3.decode(tacse3.encode_ack(nack)), nack)
+        rec = tacse3.encode_command(1, "START_RECORDING", 7, recording=12345)
+        self.assertEqual(rec.data.hex(" ").upper(), "08 01 39 30 00 00 70 9F")
+        self.assertEqual(tacse3.decode(rec).arguments, {"RecordingNumber": 12345})
+        self.assertEqual(tacse3.encode_command(1, "STOP_RECORDING", 8).data.hex(" ").upper(),
+                         "09 01 00 00 00 00 80 E0")
+        busy = tacse3.decode(frame(0x031, "08 09 39 30 00 00 70 6B"))
+        self.assertEqual((busy.command, busy.result, busy.data),
+                         ("START_RECORDING", "ALREADY_RECORDING", [0x39, 0x30, 0, 0]))
+        idle = tacse3.decode(frame(0x031, "09 0A 00 00 00 00 80 DE"))
+        self.assertEqual((idle.command, idle.result), ("STOP_RECORDING", "NOT_RECORDING"))
 
 
 class Scaling(unittest.TestCase):
@@ -181,13 +196,16 @@ class CommandArguments(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "TARE takes no arguments"):
             tacse3.encode_command(1, "TARE", 0, stream=1)
         with self.assertRaisesRegex(ValueError, "unknown command"):
-            tacse3.encode_command(1, 9, 0)
+            tacse3.encode_command(1, 10, 0)
+        with self.assertRaisesRegex(ValueError, "recording=65536 is outside 0 .. 65535"):
+            tacse3.encode_command(1, "START_RECORDING", 0, recording=65536)
 
     def test_every_command_encodes(self):
         args = {"TARE": {}, "RESET_POSE": {}, "SET_FINGER_SEPARATION": {"finger_separation": 0.1},
                 "SET_FUSION": {"fusion": "PAPER", "velocity_mode": "VELOCITY"},
                 "SET_RATE_DIVIDER": {"rate_divider": 4}, "SET_STREAM": {"stream": 0},
-                "QUERY": {"query": "STREAM"}}
+                "QUERY": {"query": "STREAM"}, "START_RECORDING": {"recording": 65535},
+                "STOP_RECORDING": {}}
         self.assertEqual(set(args), set(table.COMMANDS.values()))
         for name, kw in args.items():
             cmd = tacse3.decode(tacse3.encode_command(7, name, 9, **kw))

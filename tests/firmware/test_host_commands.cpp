@@ -256,7 +256,7 @@ TEST_F(HostCommands, BadInputFromAPeerThatVanishesIsSaidOnceAndHarmsNothing) {
   // The daemon still answers.
   const RunResult q = ctl("--seq 2 query protocol-version");
   EXPECT_EQ(q.status, 0) << q.out << read_all(log_);
-  EXPECT_EQ(q.out, "node 1: QUERY protocol version 1.0.0 (seq 2)\n");
+  EXPECT_EQ(q.out, "node 1: QUERY protocol version 1.1.0 (seq 2)\n");
   ch.reset();
   EXPECT_EQ(stop_daemon(), 0) << read_all(log_);
   const std::string err = read_all(log_);

@@ -82,6 +82,7 @@ tp::StatusGroup scenario_status(int k) {
   g.status.slip_left = k >= 96 && k < 108;
   g.status.confidence = k < 12 ? kNaN : 0.5 + 0.002 * (k % 200);
   g.status.rejected_commands = 0;
+  g.status.calibrated = k >= 6;  // both values of the flag in the log
   g.contact.area_left_m2 = k < 12 ? 0.0 : 0.00012 + 1e-7 * k;
   g.contact.area_right_m2 = k < 12 ? 0.0 : 0.00011;
   g.contact.confidence_left = 0.8;

@@ -36,10 +36,13 @@ TEST(Commands, ValidCommandsAreAccepted) {
   EXPECT_EQ(code_of(cmd({0x05, 0x01, 120, 0, 0, 0, 0})), tp::AckCode::kAck);
   EXPECT_EQ(code_of(cmd({0x06, 0x01, 1, 0, 0, 0, 0})), tp::AckCode::kAck);
   EXPECT_EQ(code_of(cmd({0x07, 0x01, 4, 0, 0, 0, 0})), tp::AckCode::kAck);
+  EXPECT_EQ(code_of(cmd({0x08, 0x01, 0, 0, 0, 0, 0})), tp::AckCode::kAck);        // recording 0
+  EXPECT_EQ(code_of(cmd({0x08, 0x01, 0xFF, 0xFF, 0, 0, 0})), tp::AckCode::kAck);  // 65535
+  EXPECT_EQ(code_of(cmd({0x09, 0x01, 0, 0, 0, 0, 0})), tp::AckCode::kAck);
 }
 
 TEST(Commands, UnknownCommand) {
-  for (int code : {0x00, 0x08, 0x10, 0xFF}) {
+  for (int code : {0x00, 0x0A, 0x10, 0xFF}) {
     const tp::CommandResult r = tp::validate_command(
         cmd({static_cast<std::uint8_t>(code), 0x01, 0, 0, 0, 0, 0x20}), tp::Endpoint{});
     EXPECT_TRUE(r.addressed);
@@ -96,6 +99,8 @@ TEST(Commands, ReservedBitsMustBeZero) {
   EXPECT_EQ(code_of(cmd({0x05, 0x01, 2, 1, 0, 0, 0})), tp::AckCode::kReservedNotZero);
   EXPECT_EQ(code_of(cmd({0x06, 0x01, 1, 0, 1, 0, 0})), tp::AckCode::kReservedNotZero);
   EXPECT_EQ(code_of(cmd({0x07, 0x01, 0, 0, 0, 1, 0})), tp::AckCode::kReservedNotZero);
+  EXPECT_EQ(code_of(cmd({0x08, 0x01, 7, 0, 1, 0, 0})), tp::AckCode::kReservedNotZero);
+  EXPECT_EQ(code_of(cmd({0x09, 0x01, 7, 0, 0, 0, 0})), tp::AckCode::kReservedNotZero);
   EXPECT_EQ(code_of(cmd({0x01, 0x01, 0, 0, 0, 0, 0x01})), tp::AckCode::kReservedNotZero);
 }
 
@@ -139,7 +144,7 @@ TEST(Commands, ReceiverCountsEveryRejection) {
   bad_crc.data[7] ^= 0x80;
   const std::vector<tp::CanFrame> frames = {
       cmd({0x01, 0x01, 0, 0, 0, 0, 0}),    // ok
-      cmd({0x09, 0x01, 0, 0, 0, 0, 0}),    // unknown
+      cmd({0x0A, 0x01, 0, 0, 0, 0, 0}),    // unknown
       short_frame,                         // length
       bad_crc,                             // crc
       cmd({0x01, 0x05, 0, 0, 0, 0, 0}),    // wrong node

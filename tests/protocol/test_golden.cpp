@@ -266,6 +266,7 @@ TEST(Golden, StatusGroup) {
   EXPECT_DOUBLE_EQ(s.confidence, 0.9);
   EXPECT_EQ(s.rate_divider, 2);
   EXPECT_EQ(s.rejected_commands, 3);
+  EXPECT_FALSE(s.calibrated);
   EXPECT_EQ(s.counter, 7);
   ASSERT_EQ(tp::decode(f[1], tp::IdLayout{}, d), tp::Status::kOk);
   const auto& c = payload_as<tp::ContactMsg>(d);
@@ -283,6 +284,26 @@ TEST(Golden, StatusGroup) {
   EXPECT_EQ(n.dropped_left, 1);
   EXPECT_EQ(n.dropped_right, 513);
   EXPECT_EQ(n.can_tx_dropped, 65535);
+}
+
+// Calibrated is bit 48 (byte 6 bit 0, below the counter): the StatusGroup Status with it set.
+TEST(Golden, StatusCalibratedFlag) {
+  const Bytes clear = {0x42, 0xBB, 0xE1, 0x02, 0x00, 0x03, 0x70, 0x72};
+  const Bytes set = {0x42, 0xBB, 0xE1, 0x02, 0x00, 0x03, 0x71, 0x6F};
+  for (const Bytes& b : {clear, set}) {
+    const bool calibrated = b[6] & 1u;
+    SCOPED_TRACE(calibrated);
+    tp::Decoded d;
+    ASSERT_EQ(tp::decode(frame(0x028, b), tp::IdLayout{}, d), tp::Status::kOk);
+    tp::StatusMsg s = payload_as<tp::StatusMsg>(d);
+    EXPECT_EQ(s.calibrated, calibrated);
+    EXPECT_EQ(s.state, tp::State::kTracking);
+    EXPECT_EQ(s.rejected_commands, 3);
+    EXPECT_EQ(s.counter, 7);
+    tp::CanFrame f;
+    ASSERT_EQ(tp::encode(s, node1(), f), tp::Status::kOk);
+    EXPECT_EQ(payload(f), b);
+  }
 }
 
 TEST(Golden, Commands) {
@@ -315,6 +336,10 @@ TEST(Golden, Commands) {
   tp::Command q = cmd(tp::CommandCode::kQuery, 6);
   q.query = tp::QueryItem::kStream;
   cases.push_back({q, {0x07, 0x01, 0x04, 0, 0, 0, 0x60, 0xE6}});
+  tp::Command rec = cmd(tp::CommandCode::kStartRecording, 7);
+  rec.recording_number = 12345;
+  cases.push_back({rec, {0x08, 0x01, 0x39, 0x30, 0, 0, 0x70, 0x9F}});
+  cases.push_back({cmd(tp::CommandCode::kStopRecording, 8), {0x09, 0x01, 0, 0, 0, 0, 0x80, 0xE0}});
 
   for (const Case& c : cases) {
     SCOPED_TRACE(tp::to_string(c.cmd.code));
@@ -331,6 +356,45 @@ TEST(Golden, Commands) {
   }
   const tp::CommandResult r = tp::validate_command(frame(0x030, cases[2].bytes), tp::Endpoint{});
   EXPECT_DOUBLE_EQ(r.command.finger_separation_m, 0.085);
+  const tp::CommandResult rr = tp::validate_command(frame(0x030, cases[7].bytes), tp::Endpoint{});
+  EXPECT_EQ(rr.command.recording_number, 12345);
+}
+
+// The recording commands' answers: ACK echoes the number, the NACK reasons have their own codes.
+TEST(Golden, RecordingAcks) {
+  struct Case {
+    Bytes bytes;
+    tp::CommandCode command;
+    tp::AckCode result;
+  };
+  const Case cases[] = {
+      {{0x08, 0x00, 0x39, 0x30, 0, 0, 0x70, 0x27},
+       tp::CommandCode::kStartRecording,
+       tp::AckCode::kAck},
+      {{0x08, 0x09, 0x39, 0x30, 0, 0, 0x70, 0x6B},
+       tp::CommandCode::kStartRecording,
+       tp::AckCode::kAlreadyRecording},
+      {{0x09, 0x0A, 0, 0, 0, 0, 0x80, 0xDE},
+       tp::CommandCode::kStopRecording,
+       tp::AckCode::kNotRecording},
+  };
+  for (const Case& c : cases) {
+    tp::Decoded d;
+    ASSERT_EQ(tp::decode(frame(0x031, c.bytes), tp::IdLayout{}, d), tp::Status::kOk);
+    const auto& a = payload_as<tp::Ack>(d);
+    EXPECT_EQ(a.command, c.command);
+    EXPECT_EQ(a.result, c.result);
+    tp::CanFrame f;
+    ASSERT_EQ(tp::encode(a, node1(), f), tp::Status::kOk);
+    EXPECT_EQ(payload(f), c.bytes);
+  }
+  // The gripper's ACK to the golden START_RECORDING 12345 is the first line.
+  const tp::CommandResult r =
+      tp::validate_command(frame(0x030, {0x08, 0x01, 0x39, 0x30, 0, 0, 0x70, 0x9F}), {});
+  ASSERT_EQ(r.code, tp::AckCode::kAck);
+  tp::CanFrame f;
+  ASSERT_EQ(tp::encode(tp::make_ack(r), node1(), f), tp::Status::kOk);
+  EXPECT_EQ(payload(f), cases[0].bytes);
 }
 
 TEST(Golden, Acks) {

@@ -102,7 +102,8 @@ struct PayloadJson {
            ",\"stream_enabled\":" + boolean(m.stream_enabled) + ",\"fusion\":" + name(m.fusion) +
            ",\"velocity_mode\":" + name(m.velocity_mode) + ",\"confidence\":" + num(m.confidence) +
            ",\"rate_divider\":" + std::to_string(m.rate_divider) + ",\"fault\":" + name(m.fault) +
-           ",\"rejected_commands\":" + std::to_string(m.rejected_commands) + "}";
+           ",\"rejected_commands\":" + std::to_string(m.rejected_commands) +
+           ",\"calibrated\":" + boolean(m.calibrated) + "}";
   }
   std::string operator()(const tp::ContactMsg& m) const {
     return "{\"counter\":" + std::to_string(m.counter) + ",\"area_left\":" + num(m.area_left_m2) +
@@ -138,6 +139,9 @@ struct PayloadJson {
         break;
       case tp::CommandCode::kQuery:
         a = "\"QueryItem\":" + name(c.query);
+        break;
+      case tp::CommandCode::kStartRecording:
+        a = "\"RecordingNumber\":" + std::to_string(c.recording_number);
         break;
       default:
         break;
@@ -272,6 +276,7 @@ struct Gen {
     g.status.rate_divider = static_cast<std::uint8_t>(integer(0, 255));
     g.status.fault = static_cast<tp::FaultCode>(integer(0, 9));
     g.status.rejected_commands = static_cast<std::uint8_t>(integer(0, 255));
+    g.status.calibrated = chance(0.5);
     g.contact = {value(0.004), value(0.004), value(0.6) + 0.5, value(0.6) + 0.5, 0};
     g.timing = {value(0.04) + 0.03, value(0.04) + 0.03, value(0.04) + 0.03, 0};
     g.counters = {static_cast<std::uint16_t>(integer(0, 65535)),
@@ -316,6 +321,8 @@ std::string command_arguments(const tp::Command& c) {
       return "{\"stream\":" + std::to_string(c.stream_enabled ? 1 : 0) + "}";
     case tp::CommandCode::kQuery:
       return "{\"query\":" + name(c.query) + "}";
+    case tp::CommandCode::kStartRecording:
+      return "{\"recording\":" + std::to_string(c.recording_number) + "}";
     default:
       return "{}";
   }
@@ -344,7 +351,7 @@ void ack_case(const tp::Ack& a, tp::TxConfig tx) {
 
 void commands(Gen& g) {
   for (int i = 0; i < 40; ++i) {
-    for (unsigned code = 1; code <= 7; ++code) {
+    for (unsigned code = 1; code <= 9; ++code) {
       tp::Command c;
       c.code = static_cast<tp::CommandCode>(code);
       c.sequence = static_cast<std::uint8_t>(g.integer(0, 15));
@@ -354,11 +361,12 @@ void commands(Gen& g) {
       c.rate_divider = static_cast<std::uint8_t>(g.integer(0, 130));
       c.stream_enabled = g.chance(0.5);
       c.query = static_cast<tp::QueryItem>(g.integer(0, 5));
+      c.recording_number = static_cast<std::uint16_t>(g.integer(0, 65535));
       command_case(c, g.tx());
     }
     tp::Ack a;
-    a.command = static_cast<tp::CommandCode>(g.integer(1, 9));
-    a.result = static_cast<tp::AckCode>(g.integer(0, 9));
+    a.command = static_cast<tp::CommandCode>(g.integer(1, 11));
+    a.result = static_cast<tp::AckCode>(g.integer(0, 14));
     a.sequence = static_cast<std::uint8_t>(g.integer(0, 15));
     for (auto& b : a.data) b = static_cast<std::uint8_t>(g.integer(0, 255));
     ack_case(a, g.tx());

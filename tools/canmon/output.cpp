@@ -177,14 +177,14 @@ void JsonSink::on_message(std::uint8_t node, std::uint64_t rx_time_us, const tp:
                  ",\"counter\":%u,\"state\":%s,\"health_left\":%s,\"health_right\":%s,"
                  "\"contact_left\":%s,\"contact_right\":%s,\"slip_left\":%s,\"slip_right\":%s,"
                  "\"stream_enabled\":%s,\"fusion\":%s,\"velocity_mode\":%s,\"confidence\":%s,"
-                 "\"rate_divider\":%u,\"fault\":%s,\"rejected_commands\":%u}\n",
+                 "\"rate_divider\":%u,\"fault\":%s,\"rejected_commands\":%u,\"calibrated\":%s}\n",
                  nd, rx_time_us, unsigned{s->counter}, enum_json(s->state).c_str(),
                  enum_json(s->health_left).c_str(), enum_json(s->health_right).c_str(),
                  b(s->contact_left), b(s->contact_right), b(s->slip_left), b(s->slip_right),
                  b(s->stream_enabled), enum_json(s->fusion).c_str(),
                  enum_json(s->velocity_mode).c_str(),
                  json_num(s->confidence, kDecConfidence).c_str(), unsigned{s->rate_divider},
-                 enum_json(s->fault).c_str(), unsigned{s->rejected_commands});
+                 enum_json(s->fault).c_str(), unsigned{s->rejected_commands}, b(s->calibrated));
   } else if (const auto* c = std::get_if<tp::ContactMsg>(&d.payload)) {
     std::fprintf(out_,
                  "{\"type\":\"status_contact\",\"node\":%u,\"rx_us\":%" PRIu64
@@ -294,13 +294,14 @@ void TtySink::draw() {
       const tp::StatusMsg& st = *n.status;
       std::snprintf(line, sizeof line,
                     "node %-2u %-22s L:%-6s R:%-6s contact %c%c slip %c%c conf %s  %s/%s  "
-                    "div %u  stream %s\n",
+                    "div %u  stream %s%s\n",
                     id, enum_text(st.state).c_str(), enum_text(st.health_left).c_str(),
                     enum_text(st.health_right).c_str(), st.contact_left ? 'L' : '-',
                     st.contact_right ? 'R' : '-', st.slip_left ? 'L' : '-',
                     st.slip_right ? 'R' : '-', fixed(st.confidence, 3).c_str(),
                     enum_text(st.fusion).c_str(), enum_text(st.velocity_mode).c_str(),
-                    unsigned{st.rate_divider}, st.stream_enabled ? "on" : "off");
+                    unsigned{st.rate_divider}, st.stream_enabled ? "on" : "off",
+                    st.calibrated ? "" : "  UNCALIBRATED");
     } else {
       std::snprintf(line, sizeof line, "node %-2u (no status yet)\n", id);
     }

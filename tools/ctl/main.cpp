@@ -65,6 +65,11 @@ std::string describe_reply(const tp::Ack& a) {
     }
     return "unknown query item";
   }
+  if (a.command == tp::CommandCode::kStartRecording) {
+    std::snprintf(buf, sizeof buf, "acknowledged: recording rec-%05u",
+                  a.data[0] | (static_cast<unsigned>(a.data[1]) << 8));
+    return buf;
+  }
   return "acknowledged";
 }
 
@@ -78,6 +83,7 @@ int main(int argc, char** argv) {
       "  tacse3-ctl --socket /tmp/tacse3-can.sock --node 1 reset-pose   (tacse3d --can-socket)\n"
       "  tacse3-ctl --log-out - --node 1 tare            (print the frame as candump -L)\n"
       "  tacse3-ctl --log-out cmd.log --ack-from replies.log --node 1 query stream\n"
+      "  tacse3-ctl --iface can0 --node 1 record-start 7   (then: record-stop)\n"
       "Exit status: 0 ACK, 1 error, 2 usage, 3 NACK, 4 no ACK before the timeout.",
       "tacse3-ctl"};
   std::string iface, socket_path, log_out, ack_from, base = "0x1ACE0000";
@@ -189,6 +195,19 @@ int main(int argc, char** argv) {
                 : item == "fusion"            ? tp::QueryItem::kFusion
                 : item == "stream"            ? tp::QueryItem::kStream
                                               : tp::QueryItem::kProtocolVersion;
+  });
+  unsigned recording = 0;
+  auto* rec = app.add_subcommand("record-start",
+                                 "Start recording to the board's record directory, rec-NNNNN");
+  rec->add_option("N", recording, "Recording number 0 .. 65535")
+      ->required()
+      ->check(CLI::Range(0u, 65535u));
+  rec->callback([&] {
+    cmd.code = tp::CommandCode::kStartRecording;
+    cmd.recording_number = static_cast<std::uint16_t>(recording);
+  });
+  app.add_subcommand("record-stop", "Stop the recording")->callback([&] {
+    cmd.code = tp::CommandCode::kStopRecording;
   });
   if (const int rc = tacse3::tools::parse_command_line(app, argc, argv); rc >= 0) return rc;
 

@@ -112,6 +112,15 @@ class Client:
     def set_stream(self, enabled):
         return self.send("SET_STREAM", stream=int(bool(enabled)))
 
+    def start_recording(self, number):
+        """Record to rec-NNNNN (5 digits) under the gripper's record directory; NackError with
+        ALREADY_RECORDING, NO_RECORD_DIR, RECORDING_EXISTS or DISK_ERROR."""
+        return self.send("START_RECORDING", recording=number)
+
+    def stop_recording(self):
+        """Stop the recording; NackError NOT_RECORDING, or DISK_ERROR if a write had failed."""
+        return self.send("STOP_RECORDING")
+
     def query(self, item):
         """The reply to QUERY ``item`` (PROTOCOL_VERSION, FIRMWARE_VERSION, FINGER_SEPARATION,
         FUSION, STREAM) as a dict, see messages.Ack.query_reply."""

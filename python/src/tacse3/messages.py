@@ -46,7 +46,7 @@ class Status(_Message):
         "stream_enabled": "StreamEnabled", "fusion": "FusionMethod",
         "velocity_mode": "VelocityMode", "confidence": "Confidence",
         "rate_divider": "RateDivider", "fault": "FaultCode",
-        "rejected_commands": "RejectedCommands"}
+        "rejected_commands": "RejectedCommands", "calibrated": "Calibrated"}
     node: int = 1
     counter: int = 0
     state: object = "BOOTING"
@@ -63,6 +63,7 @@ class Status(_Message):
     rate_divider: int = 1
     fault: object = "NONE"
     rejected_commands: int = 0  # mod 256
+    calibrated: bool = False  # a fitted calibration runs (False: UNCALIBRATED)
 
 
 @dataclass
@@ -328,7 +329,8 @@ def encode_cycle(cycle, counter, layout=IdLayout(), fd=False, brs=True):
 # Keyword argument of encode_command -> the Command signal it sets.
 COMMAND_ARGUMENTS = {"finger_separation": "FingerSeparation", "fusion": "FusionMethod",
                      "velocity_mode": "VelocityMode", "rate_divider": "RateDivider",
-                     "stream": "StreamEnable", "query": "QueryItem"}
+                     "stream": "StreamEnable", "query": "QueryItem",
+                     "recording": "RecordingNumber"}
 
 
 def _command_code(command):
@@ -359,10 +361,11 @@ def _argument_raw(sig, key, value):
 
 def encode_command(node, command, sequence, layout=IdLayout(), fd=False, **arguments):
     """The command frame addressed to ``node`` (identifier and TargetNode). ``command`` is a name
-    (TARE, RESET_POSE, SET_FINGER_SEPARATION, SET_FUSION, SET_RATE_DIVIDER, SET_STREAM, QUERY) or
-    code; its arguments are keywords (see COMMAND_ARGUMENTS): SET_FINGER_SEPARATION
-    finger_separation [m]; SET_FUSION fusion, velocity_mode; SET_RATE_DIVIDER rate_divider;
-    SET_STREAM stream; QUERY query. ValueError if one is missing, extra or out of range."""
+    (TARE, RESET_POSE, SET_FINGER_SEPARATION, SET_FUSION, SET_RATE_DIVIDER, SET_STREAM, QUERY,
+    START_RECORDING, STOP_RECORDING) or code; its arguments are keywords (see
+    COMMAND_ARGUMENTS): SET_FINGER_SEPARATION finger_separation [m]; SET_FUSION fusion,
+    velocity_mode; SET_RATE_DIVIDER rate_divider; SET_STREAM stream; QUERY query;
+    START_RECORDING recording (0..65535). ValueError if one is missing, extra or out of range."""
     mdef = table.BY_NAME["Command"]
     code = _command_code(command)
     wanted = {k for k, s in COMMAND_ARGUMENTS.items() if mdef.signal(s).mux == code}

@@ -154,6 +154,7 @@ for (const line of fs.readFileSync(logPath, 'utf8').split('\n')) {
       slip_left: b(s.SlipLeft), slip_right: b(s.SlipRight), stream_enabled: b(s.StreamEnabled),
       fusion: s.FusionMethod, velocity_mode: s.VelocityMode, confidence: s.Confidence,
       rate_divider: s.RateDivider, fault: s.FaultCode, rejected_commands: s.RejectedCommands,
+      calibrated: b(s.Calibrated),
     });
   } else if (name === 'StatusContact') {
     emit({ type: 'status_contact', node, counter: s.Counter, area_left: s.AreaLeft,

@@ -16,7 +16,7 @@
 namespace tacse3::protocol {
 
 inline constexpr std::uint8_t kProtocolVersionMajor = 1;
-inline constexpr std::uint8_t kProtocolVersionMinor = 0;
+inline constexpr std::uint8_t kProtocolVersionMinor = 1;
 inline constexpr std::uint8_t kProtocolVersionPatch = 0;
 
 // How the gripper (or the controller, for commands) transmits.
@@ -117,6 +117,7 @@ struct StatusMsg {
   std::uint8_t rate_divider = 1;
   FaultCode fault = FaultCode::kNone;
   std::uint8_t rejected_commands = 0;  // mod 256
+  bool calibrated = false;             // a fitted calibration runs (0: UNCALIBRATED)
   std::uint8_t counter = 0;
 };
 
@@ -153,6 +154,7 @@ struct Command {
   std::uint8_t rate_divider = 1;                     // kSetRateDivider
   bool stream_enabled = true;                        // kSetStream
   QueryItem query = QueryItem::kProtocolVersion;     // kQuery
+  std::uint16_t recording_number = 0;                // kStartRecording
   std::array<std::uint8_t, 4> args{};                // decoded payload bytes 2..5 as received
 };
 

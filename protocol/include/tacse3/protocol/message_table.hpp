@@ -131,11 +131,21 @@ inline constexpr ValueName kFaultNames[] = {{0, "NONE"},
 inline constexpr ValueName kCommandNames[] = {
     {1, "TARE"},       {2, "RESET_POSE"},       {3, "SET_FINGER_SEPARATION"},
     {4, "SET_FUSION"}, {5, "SET_RATE_DIVIDER"}, {6, "SET_STREAM"},
-    {7, "QUERY"}};
-inline constexpr ValueName kAckNames[] = {
-    {0, "ACK"},           {1, "UNKNOWN_COMMAND"}, {2, "BAD_LENGTH"},        {3, "BAD_CRC"},
-    {4, "WRONG_NODE"},    {5, "OUT_OF_RANGE"},    {6, "RESERVED_NOT_ZERO"}, {7, "BUSY"},
-    {8, "INTERNAL_ERROR"}};
+    {7, "QUERY"},      {8, "START_RECORDING"},  {9, "STOP_RECORDING"}};
+inline constexpr ValueName kAckNames[] = {{0, "ACK"},
+                                          {1, "UNKNOWN_COMMAND"},
+                                          {2, "BAD_LENGTH"},
+                                          {3, "BAD_CRC"},
+                                          {4, "WRONG_NODE"},
+                                          {5, "OUT_OF_RANGE"},
+                                          {6, "RESERVED_NOT_ZERO"},
+                                          {7, "BUSY"},
+                                          {8, "INTERNAL_ERROR"},
+                                          {9, "ALREADY_RECORDING"},
+                                          {10, "NOT_RECORDING"},
+                                          {11, "NO_RECORD_DIR"},
+                                          {12, "RECORDING_EXISTS"},
+                                          {13, "DISK_ERROR"}};
 inline constexpr ValueName kQueryNames[] = {{0, "PROTOCOL_VERSION"},
                                             {1, "FIRMWARE_VERSION"},
                                             {2, "FINGER_SEPARATION"},
@@ -358,6 +368,8 @@ inline constexpr SignalDef kStatus[] = {
     count("RateDivider", 24, 8, 1, 120, "", "Stream rate = 120 Hz / RateDivider"),
     enumeration("FaultCode", 32, 8, kFaultNames, "Most recent fault or warning, 0 = none"),
     count("RejectedCommands", 40, 8, 0, 255, "", "Rejected command frames since boot, mod 256"),
+    flag("Calibrated", 48,
+         "1 = a fitted calibration runs; 0 = UNCALIBRATED, estimates not to scale"),
     counter("Counter", "Status counter, shared by the status frames of one emission"),
     crc(56),
 };
@@ -399,12 +411,16 @@ inline constexpr SignalDef kFingerSeparationArg = {
     .mux = 3,
     .comment = "Distance between the two sensor pads"};
 
+inline constexpr SignalDef kRecordingNumberArg =
+    count("RecordingNumber", 16, 16, 0, 65535, "",
+          "Recording number N, chosen by the controller: the recording goes to rec-NNNNN", 8);
+
 inline constexpr SignalDef kCommand[] = {
     {.name = "CommandCode",
      .start = 0,
      .length = 8,
      .raw_min = 1,
-     .raw_max = 7,
+     .raw_max = 9,
      .role = Role::kMultiplexor,
      .values = kCommandNames,
      .comment = "Command code"},
@@ -415,6 +431,7 @@ inline constexpr SignalDef kCommand[] = {
     count("RateDivider", 16, 8, 1, 120, "", "Stream rate = 120 Hz / RateDivider", 5),
     count("StreamEnable", 16, 8, 0, 1, "", "1 = enable, 0 = disable the cyclic stream", 6),
     enumeration("QueryItem", 16, 8, kQueryNames, "What to report in the Ack", 7),
+    kRecordingNumberArg,
     counter("Sequence", "Chosen by the controller, echoed in the Ack"),
     crc(56),
 };
@@ -436,6 +453,7 @@ inline constexpr SignalDef kAck[] = {
     count("StreamEnable", 16, 8, 0, 1, "", "1 = enable, 0 = disable the cyclic stream", 6),
     enumeration("QueryItem", 16, 8, kQueryNames, "Item reported in QueryData", 7),
     count("QueryData", 24, 24, 0, 0xFFFFFF, "", "Item data, layout per QueryItem (see docs)", 7),
+    kRecordingNumberArg,
     counter("Sequence", "Sequence of the command being answered"),
     crc(56),
 };

@@ -85,6 +85,8 @@ enum class CommandCode : std::uint8_t {
   kSetRateDivider = 0x05,
   kSetStream = 0x06,
   kQuery = 0x07,
+  kStartRecording = 0x08,
+  kStopRecording = 0x09,
 };
 
 // Result byte of the Ack frame: 0 = ACK, anything else is a NACK with that reason.
@@ -98,6 +100,12 @@ enum class AckCode : std::uint8_t {
   kReservedNotZero = 6,
   kBusy = 7,  // valid, but not allowed in the current state (firmware decides)
   kInternalError = 8,
+  // Recording commands (the firmware's decision, like kBusy).
+  kAlreadyRecording = 9,
+  kNotRecording = 10,
+  kNoRecordDir = 11,      // the board file has no [record] dir and tacse3d no --record-root
+  kRecordingExists = 12,  // the recording number's directory exists: never overwritten
+  kDiskError = 13,        // the recording could not be created, or a write failed
 };
 
 enum class QueryItem : std::uint8_t {
@@ -198,6 +206,10 @@ constexpr const char* to_string(CommandCode c) noexcept {
       return "SET_STREAM";
     case CommandCode::kQuery:
       return "QUERY";
+    case CommandCode::kStartRecording:
+      return "START_RECORDING";
+    case CommandCode::kStopRecording:
+      return "STOP_RECORDING";
   }
   return nullptr;
 }
@@ -222,6 +234,16 @@ constexpr const char* to_string(AckCode a) noexcept {
       return "BUSY";
     case AckCode::kInternalError:
       return "INTERNAL_ERROR";
+    case AckCode::kAlreadyRecording:
+      return "ALREADY_RECORDING";
+    case AckCode::kNotRecording:
+      return "NOT_RECORDING";
+    case AckCode::kNoRecordDir:
+      return "NO_RECORD_DIR";
+    case AckCode::kRecordingExists:
+      return "RECORDING_EXISTS";
+    case AckCode::kDiskError:
+      return "DISK_ERROR";
   }
   return nullptr;
 }
