@@ -144,6 +144,7 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
   d->board_ = board;
   d->options_ = options;
   d->calibration_ = calibration;
+  d->shared_.calibrated.store(calibration.fitted(), std::memory_order_relaxed);
   d->log_ = log;
 
   // Pipeline: ~1.2 MB, allocated once here.
@@ -398,12 +399,14 @@ bool Daemon::reload_calibration(std::string* message) {
   if (!dsp_ready_.load(std::memory_order_acquire)) {
     *message = "calibration " + calibration_.file.string() + " queued (the loop is not running)";
     calibration_ = next;
+    shared_.calibrated.store(calibration_.fitted(), std::memory_order_relaxed);
     return true;
   }
   for (int i = 0; i < 1000; ++i) {
     const int f = shared_.calibration_flag.load(std::memory_order_acquire);
     if (f == SharedState::kApplied) {
       calibration_ = next;
+      shared_.calibrated.store(calibration_.fitted(), std::memory_order_relaxed);
       *message = "calibration reloaded from " + calibration_.file.string();
       return true;
     }

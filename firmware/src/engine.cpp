@@ -350,6 +350,7 @@ protocol::StatusMsg Engine::status_message() const noexcept {
   }
   m.rejected_commands =
       static_cast<std::uint8_t>(shared_.rejected_commands.load(std::memory_order_relaxed));
+  m.calibrated = shared_.calibrated.load(std::memory_order_relaxed);
   return m;
 }
 

@@ -190,6 +190,36 @@ TEST_F(RunTest, CheckAndErrorsUseTheDocumentedExitCodes) {
   EXPECT_NE(r.out.find("board \"no-such-board\" not found"), std::string::npos) << r.out;
 }
 
+// The Status frame's Calibrated flag, as tacse3-canmon decodes it: 1 on the sim board with the
+// simulator's fitted calibration (what tacse3d picks there without --calibration), 0 with a
+// calibration file that fits nothing (the UNCALIBRATED run).
+TEST_F(RunTest, StatusSaysWhetherTheRunIsCalibrated) {
+  std::ofstream(dir_ / "unfitted.toml") << "format = \"tacse3-calibration\"\nversion = 1\n";
+  for (const bool fitted : {true, false}) {
+    SCOPED_TRACE(fitted ? "sim calibration" : "unfitted calibration");
+    const fs::path log = dir_ / (fitted ? "fitted.log" : "unfitted.log");
+    const std::string cal =
+        fitted ? std::string() : " --calibration " + (dir_ / "unfitted.toml").string();
+    const RunResult d = run_cmd(std::string(TACSE3D_BIN) + " --board sim --seconds " + seconds(1) +
+                                cal + " --can-log " + log.string() + " 2>&1");
+    ASSERT_EQ(d.status, 0) << d.out;
+    EXPECT_EQ(d.out.find("UNCALIBRATED") != std::string::npos, !fitted) << d.out;
+    const RunResult c = run_cmd(std::string(TACSE3_CANMON_BIN) + " --log " + log.string() +
+                                " --format json 2>/dev/null");
+    ASSERT_EQ(c.status, 0);
+    std::size_t statuses = 0, calibrated = 0, uncalibrated = 0;
+    for (const std::string& line : split(c.out, '\n')) {
+      if (line.find("\"type\":\"status\"") == std::string::npos) continue;
+      ++statuses;
+      calibrated += line.find("\"calibrated\":true") != std::string::npos ? 1 : 0;
+      uncalibrated += line.find("\"calibrated\":false") != std::string::npos ? 1 : 0;
+    }
+    EXPECT_GE(statuses, 5u) << "10 Hz heartbeat over a second";
+    EXPECT_EQ(calibrated, fitted ? statuses : 0u);
+    EXPECT_EQ(uncalibrated, fitted ? 0u : statuses);
+  }
+}
+
 #ifdef TACSE3_SIM_BIN
 TEST_F(RunTest, ReplayBoardStreamsEveryFramePairOfARecording) {
   // A short recording from tacse3-sim, replayed by both sensors as fast as the loop takes it

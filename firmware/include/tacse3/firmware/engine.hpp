@@ -50,6 +50,7 @@ struct SharedState {
   std::atomic<int> calibration_flag{kIdle};
   std::array<dsp::Calibration, 2> calibration{};
   std::atomic<bool> calibration_invalid{false};  // the last reload failed (status fault code)
+  std::atomic<bool> calibrated{false};  // daemon: a fitted calibration runs (Status Calibrated)
 };
 
 struct EngineConfig {
