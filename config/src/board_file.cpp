@@ -344,9 +344,9 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
              std::to_string(kBoardVersion) + ")";
     return false;
   }
-  rd.only_keys(
-      root, "",
-      {"version", "name", "description", "sensors", "sim", "pipeline", "can", "gpio", "realtime"});
+  rd.only_keys(root, "",
+               {"version", "name", "description", "sensors", "sim", "pipeline", "can", "gpio",
+                "realtime", "record"});
   rd.string(root, "name", "", &b.name);
   rd.string(root, "description", "", &b.description);
 
@@ -456,6 +456,17 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
     rd.only_keys(*t, "realtime", {"dsp_cpu", "dsp_priority"});
     rd.integer(*t, "dsp_cpu", "realtime", -1, 1023, &b.realtime.dsp_cpu);
     rd.integer(*t, "dsp_priority", "realtime", 0, 99, &b.realtime.dsp_priority);
+  }
+
+  if (const toml::table* t = rd.table(root, "record", "")) {
+    rd.only_keys(*t, "record", {"dir"});
+    rd.string(*t, "dir", "record", &b.record.dir);
+    // The daemon's working directory is no place to depend on; the directory itself is checked
+    // when tacse3d starts (it may be a mount that is not there while the file is edited).
+    if (rd.ok() && !std::filesystem::path(b.record.dir).is_absolute()) {
+      rd.fail(t->get("dir"),
+              "key \"record.dir\" must be an absolute path, got \"" + b.record.dir + "\"");
+    }
   }
 
   if (!rd.ok()) {
@@ -593,6 +604,8 @@ std::string describe(const BoardConfig& b) {
   }
   s << "\n  realtime: dsp cpu " << b.realtime.dsp_cpu << ", SCHED_FIFO priority "
     << b.realtime.dsp_priority << "\n";
+  s << "  record: " << (b.record.dir.empty() ? "none (START_RECORDING refused)" : b.record.dir)
+    << "\n";
   return s.str();
 }
 

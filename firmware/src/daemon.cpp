@@ -331,20 +331,10 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
   // --record DIR: what the DSP thread processes, written off the DSP path (docs/firmware.md).
   if (!options.record_dir.empty()) {
 #if TACSE3_HAVE_RECORDER
-    RecorderConfig rc;
-    const config::SensorBoardConfig& s0 =
-        board.sensors[0].enabled ? board.sensors[0] : board.sensors[1];
-    rc.width = s0.width;
-    rc.height = s0.height;
-    rc.fps = s0.fps;
-    for (std::size_t s = 0; s < 2; ++s) {
-      rc.sensors[s] = board.sensors[s].enabled;
-      if (d->cameras_[s]) rc.formats[s] = d->cameras_[s]->info().format;
-    }
-    rc.pixel_pitch_mm = cal[0].pixel_pitch_m * 1e3;
-    rc.finger_separation_mm = board.pipeline.finger_separation_m * 1e3;
     std::string e;
-    d->recorder_ = FrameRecorder::start(options.record_dir, rc, &e);
+    d->recording_path_ = options.record_dir;
+    d->recorder_ = FrameRecorder::start(options.record_dir,
+                                        d->recorder_config(board.pipeline.finger_separation_m), &e);
     if (!d->recorder_) {
       *error = e;
       return nullptr;
@@ -545,9 +535,77 @@ void Daemon::report_can_socket() {
   socket_seen_ = c;
 }
 
+#if TACSE3_HAVE_RECORDER
+// What a recording of this board holds: the sensors as configured, the pixel pitch of the
+// running calibration and the given finger separation.
+RecorderConfig Daemon::recorder_config(double finger_separation_m) const {
+  RecorderConfig rc;
+  const config::SensorBoardConfig& s0 =
+      board_.sensors[0].enabled ? board_.sensors[0] : board_.sensors[1];
+  rc.width = s0.width;
+  rc.height = s0.height;
+  rc.fps = s0.fps;
+  for (std::size_t s = 0; s < 2; ++s) {
+    rc.sensors[s] = board_.sensors[s].enabled;
+    if (cameras_[s]) rc.formats[s] = cameras_[s]->info().format;
+  }
+  rc.pixel_pitch_mm = calibration_.set.sensor[0].pixel_pitch_m * 1e3;
+  rc.finger_separation_mm = finger_separation_m * 1e3;
+  return rc;
+}
+#endif
+
+// Writes what is queued, says how it went and frees the recorder.
+void Daemon::close_recording() {
+#if TACSE3_HAVE_RECORDER
+  if (!recorder_) return;
+  const std::string e = recorder_->close();
+  const recording::StreamWriterStats rs = recorder_->stats();
+  if (!e.empty()) {
+    say(0, "recording %s: %s", recording_path_.c_str(), e.c_str());
+  } else {
+    say(1,
+        "recording %s: %llu frames written, %llu dropped (ring full), %llu instants without "
+        "every pad, %llu rejected",
+        recording_path_.c_str(), static_cast<unsigned long long>(rs.written),
+        static_cast<unsigned long long>(rs.dropped_full),
+        static_cast<unsigned long long>(recorder_->skipped_incomplete()),
+        static_cast<unsigned long long>(rs.rejected));
+  }
+  recorder_.reset();
+#endif
+}
+
+// START/STOP_RECORDING's disk work, asked for by the DSP thread (RecordingMailbox). A close goes
+// first: the DSP thread asks for a new recording only after it let go of the last one.
+void Daemon::service_recording() {
+  RecordingMailbox& box = shared_.recording;
+  if (FrameRecorder* done = box.take_close(); done != nullptr && done == recorder_.get()) {
+    close_recording();
+  }
+  RecordingMailbox::StartRequest req;
+  if (recorder_ || !box.pending_start(&req)) return;
+#if TACSE3_HAVE_RECORDER
+  std::string message;
+  const protocol::AckCode code =
+      start_numbered_recording(board_.record.dir, req.number,
+                               recorder_config(req.finger_separation_m), &recorder_, &message);
+  say(code == protocol::AckCode::kAck ? 1 : 0, "%s", message.c_str());
+  if (code == protocol::AckCode::kAck) {
+    recording_path_ = numbered_recording_dir(board_.record.dir, req.number).string();
+    recording_failure_reported_ = false;
+  }
+  box.answer_start(recorder_.get(), code);
+#else
+  say(0, "START_RECORDING refused: this tacse3d was built without the recording writer");
+  box.answer_start(nullptr, protocol::AckCode::kInternalError);
+#endif
+}
+
 void Daemon::housekeeping_tick(std::int64_t now_ns, bool handle_signals) {
   check_can_log();
   report_can_socket();
+  service_recording();
 #if TACSE3_HAVE_RECORDER
   // A write error (disk full, directory gone) stops the recording, never the stream.
   if (recorder_ && !recording_failure_reported_ && recorder_->failed()) {
@@ -674,19 +732,7 @@ int Daemon::run(bool handle_signals) {
     if (c) c->stop();
   }
   channel_->service();
-#if TACSE3_HAVE_RECORDER
-  if (recorder_) {
-    const std::string e = recorder_->close();
-    const recording::StreamWriterStats rs = recorder_->stats();
-    if (!e.empty()) {
-      say(0, "recording: %s", e.c_str());
-    } else {
-      say(1, "recording %s: %llu frames written, %llu dropped (ring full)",
-          options_.record_dir.c_str(), static_cast<unsigned long long>(rs.written),
-          static_cast<unsigned long long>(rs.dropped_full));
-    }
-  }
-#endif
+  close_recording();
   check_can_log();  // frames sent during the shutdown
   if (unix_channel_ != nullptr) {
     const hal::can::UnixSocketChannel::Counters c = unix_channel_->counters();

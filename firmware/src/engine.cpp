@@ -220,10 +220,60 @@ bool Engine::apply(const protocol::Command& c) noexcept {
   return false;
 }
 
+// START/STOP_RECORDING: decided here, between two cycles; the disk work is the housekeeping
+// thread's (RecordingMailbox), so the DSP thread never waits for it. Returns false when the
+// answer is deferred: a start is answered by finish_recording_start() once the recording exists.
+bool Engine::recording_command(const protocol::Command& c, protocol::Ack& ack) noexcept {
+  using protocol::AckCode;
+  RecordingMailbox& box = shared_.recording;
+  if (c.code == protocol::CommandCode::kStartRecording) {
+    if (recorder_ != nullptr || box.start_in_flight()) {
+      ack.result = AckCode::kAlreadyRecording;
+      return true;
+    }
+    // The live separation (as last set by SET_FINGER_SEPARATION) goes into the rig block.
+    box.request_start({c.recording_number, pipeline_.config().finger_separation_m});
+    recording_ack_ = ack;
+    return false;
+  }
+  if (recorder_ == nullptr) {
+    ack.result = box.start_in_flight() ? AckCode::kBusy : AckCode::kNotRecording;
+    return true;
+  }
+  bool failed = false;
+#if TACSE3_HAVE_RECORDER
+  failed = recorder_->failed();
+#endif
+  if (!box.request_close(recorder_)) {
+    ack.result = AckCode::kBusy;  // the previous recording is still being closed
+    return true;
+  }
+  recorder_ = nullptr;
+  // A write error had already stopped it: stopped now, but the controller hears of the loss.
+  if (failed) ack.result = AckCode::kDiskError;
+  return true;
+}
+
+bool Engine::finish_recording_start() noexcept {
+  FrameRecorder* r = nullptr;
+  protocol::AckCode result = protocol::AckCode::kAck;
+  if (!shared_.recording.poll_start(&r, &result)) return false;
+  recording_ack_.result = result;
+  if (result == protocol::AckCode::kAck) recorder_ = r;
+  protocol::CanFrame f;
+  if (protocol::encode(recording_ack_, config_.tx, f) == protocol::Status::kOk) send(f);
+  ++stats_.commands;
+  return true;
+}
+
 void Engine::handle_command(const protocol::CommandResult& r) noexcept {
   if (!r.addressed) return;
   protocol::Ack ack = protocol::make_ack(r);
-  if (r.code == protocol::AckCode::kAck) {
+  const bool recording = r.command.code == protocol::CommandCode::kStartRecording ||
+                         r.command.code == protocol::CommandCode::kStopRecording;
+  if (r.code == protocol::AckCode::kAck && recording) {
+    if (!recording_command(r.command, ack)) return;  // answered by finish_recording_start()
+  } else if (r.code == protocol::AckCode::kAck) {
     if (!apply(r.command)) {
       ack.result = protocol::AckCode::kInternalError;
     } else if (r.command.code == protocol::CommandCode::kQuery) {
@@ -421,6 +471,7 @@ bool Engine::step(std::int64_t now_ns) noexcept {
   bool worked = false;
   shared_.heartbeat.fetch_add(1, std::memory_order_relaxed);
   apply_pending_calibration();
+  if (finish_recording_start()) worked = true;
 
   // Commands first: they apply between two cycles, all or nothing.
   for (CommandRing* ring : command_rings_) {

@@ -2,7 +2,9 @@
 // tacse3 firmware: --record DIR through the bounded streaming recording writer.
 #include "tacse3/firmware/recorder.hpp"
 
+#include <cstdio>
 #include <span>
+#include <system_error>
 
 namespace tacse3::firmware {
 
@@ -94,6 +96,45 @@ void FrameRecorder::record(std::int64_t t_ns, const dsp::FrameView* left,
     ++n;
   }
   writer_->push(t_ns, std::span<const recording::StreamImage>(images.data(), n));
+}
+
+std::filesystem::path numbered_recording_dir(const std::filesystem::path& root,
+                                             std::uint16_t number) {
+  char name[16];
+  std::snprintf(name, sizeof name, "rec-%05u", static_cast<unsigned>(number));
+  return root / name;
+}
+
+protocol::AckCode start_numbered_recording(const std::string& root, std::uint16_t number,
+                                           const RecorderConfig& config,
+                                           std::unique_ptr<FrameRecorder>* out,
+                                           std::string* message) {
+  if (root.empty()) {
+    *message = "START_RECORDING refused: the board file has no [record] dir";
+    return protocol::AckCode::kNoRecordDir;
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_directory(root, ec)) {
+    message->assign("START_RECORDING refused: [record] dir ")
+        .append(root)
+        .append(" is not a directory");
+    return protocol::AckCode::kDiskError;
+  }
+  const std::filesystem::path dir = numbered_recording_dir(root, number);
+  if (std::filesystem::symlink_status(dir, ec).type() != std::filesystem::file_type::not_found) {
+    message->assign("START_RECORDING refused: ")
+        .append(dir.string())
+        .append(" exists (recordings are never overwritten)");
+    return protocol::AckCode::kRecordingExists;
+  }
+  std::string e;
+  *out = FrameRecorder::start(dir, config, &e);
+  if (!*out) {
+    message->assign("START_RECORDING failed: ").append(e);
+    return protocol::AckCode::kDiskError;
+  }
+  message->assign("recording to ").append(dir.string());
+  return protocol::AckCode::kAck;
 }
 
 std::string FrameRecorder::close() {

@@ -270,3 +270,22 @@ TEST(Board, LoadRefusesWhatIsNotABoardFile) {
   EXPECT_EQ(resolve_board((dir / "fifo").string(), "", "", &e), dir / "fifo");
   fs::remove_all(dir);
 }
+
+TEST(Board, RecordDirIsAnAbsolutePath) {
+  BoardConfig b;
+  std::string e;
+  ASSERT_TRUE(parse_board(kMinimal, "test.toml", &b, &e)) << e;
+  EXPECT_EQ(b.record.dir, "") << "no [record]: START_RECORDING is refused";
+  ASSERT_TRUE(parse_board(std::string(kMinimal) + "[record]\ndir = \"/srv/tacse3/rec\"\n",
+                          "test.toml", &b, &e))
+      << e;
+  EXPECT_EQ(b.record.dir, "/srv/tacse3/rec");
+  const std::string rel = error_of(std::string(kMinimal) + "[record]\ndir = \"rec\"\n");
+  EXPECT_NE(rel.find("test.toml:5: key \"record.dir\" must be an absolute path, got \"rec\""),
+            std::string::npos)
+      << rel;
+  const std::string typo = error_of(std::string(kMinimal) + "[record]\ndirectory = \"/x\"\n");
+  EXPECT_NE(typo.find("unknown key \"record.directory\""), std::string::npos) << typo;
+  const std::string type = error_of(std::string(kMinimal) + "[record]\ndir = 1\n");
+  EXPECT_NE(type.find("key \"record.dir\" must be a string"), std::string::npos) << type;
+}

@@ -25,6 +25,9 @@
 #include "bus_events.hpp"
 #include "run_cmd.hpp"
 #include "tacse3/hal/can/unix_channel.hpp"
+#if TACSE3_HAVE_RECORDER
+#include "tacse3/recording/recording.hpp"
+#endif
 
 namespace fs = std::filesystem;
 using namespace tacse3;
@@ -95,6 +98,9 @@ class HostCommands : public ::testing::Test {
     text.replace(text.find("repeat = false"), 14, "repeat = true");
     text.replace(text.find("stale_ms = 50"), 13, "stale_ms = 1000");
     text.replace(text.find("lost_ms = 500"), 13, "lost_ms = 2000");
+    // Where START_RECORDING writes.
+    fs::create_directories(dir_ / "recordings");
+    text += "\n[record]\ndir = \"" + (dir_ / "recordings").string() + "\"\n";
     std::ofstream(dir_ / "board.toml") << text;
     log_ = dir_ / "tacse3d.err";
     pid_ = fork();
@@ -238,6 +244,78 @@ TEST_F(HostCommands, CtlTaresResetsSetsAndQueriesASimDaemon) {
   EXPECT_EQ(stop_daemon(), 0) << read_all(log_);
   EXPECT_FALSE(fs::exists(sock_)) << "the socket file outlived the daemon";
 }
+
+#if TACSE3_HAVE_RECORDER
+// A calibration session without a shell on the board: the controller sets the separation, starts
+// recording N, lets it run, stops it; the recording holds the frames and the separation it set.
+TEST_F(HostCommands, CtlStartsAndStopsARecordingWithTheLiveSeparation) {
+  auto ch = connect();
+  ASSERT_NE(ch, nullptr) << read_all(log_);
+  Monitor mon(std::move(ch));
+  const auto cycles = [&] { return mon.with([](test::BusEvents& b) { return b.cycles.size(); }); };
+  ASSERT_TRUE(wait_for([&] { return cycles() > 10; }, 120)) << read_all(log_);
+  const fs::path root = dir_ / "recordings";
+
+  RunResult r = ctl("--seq 1 record-stop");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("rejected STOP_RECORDING: NOT_RECORDING (10, seq 1)"), std::string::npos)
+      << r.out;
+  // An existing recording number is refused and left as it was.
+  fs::create_directories(root / "rec-00002");
+  std::ofstream(root / "rec-00002" / "keep.txt") << "mine\n";
+  r = ctl("--seq 2 record-start 2");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("RECORDING_EXISTS (12, seq 2)"), std::string::npos) << r.out;
+  EXPECT_EQ(read_all(root / "rec-00002" / "keep.txt"), "mine\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(root / "rec-00002"), fs::directory_iterator()), 1);
+
+  // The rig block takes the separation the controller set, not the board file's 40 mm.
+  r = ctl("--seq 3 finger-separation 0.0625");
+  ASSERT_EQ(r.status, 0) << r.out;
+  r = ctl("--seq 4 record-start 7");
+  ASSERT_EQ(r.status, 0) << r.out << read_all(log_);
+  EXPECT_EQ(r.out, "node 1: START_RECORDING acknowledged: recording rec-00007 (seq 4)\n");
+  r = ctl("--seq 5 record-start 8");
+  EXPECT_EQ(r.status, 3) << r.out;
+  EXPECT_NE(r.out.find("ALREADY_RECORDING (9, seq 5)"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(root / "rec-00008"));
+  const std::size_t at_start = cycles();
+  ASSERT_TRUE(wait_for([&] { return cycles() > at_start + 60; }, 120)) << read_all(log_);
+  r = ctl("--seq 6 record-stop");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out, "node 1: STOP_RECORDING acknowledged (seq 6)\n");
+  // Closed by the housekeeping thread, which then says how much it wrote.
+  const std::string done = "recording " + (root / "rec-00007").string() + ": ";
+  ASSERT_TRUE(wait_for([&] { return read_all(log_).find(done) != std::string::npos; }, 30))
+      << read_all(log_);
+  r = ctl("--seq 7 record-stop");
+  EXPECT_EQ(r.status, 3) << r.out;
+
+  auto reader = recording::RecordingReader::open(root / "rec-00007");
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  const recording::RecordingReader& rd = reader.value();
+  // Every instant processed while recording is in it, dropped (a full ring on a loaded machine)
+  // or skipped for a pad missing at that instant; the daemon's count is the reader's.
+  const std::string log = read_all(log_);
+  unsigned long long written = 0, dropped = 0, incomplete = 0;
+  const std::size_t at = log.find(done);
+  ASSERT_EQ(std::sscanf(log.c_str() + at + done.size(),
+                        "%llu frames written, %llu dropped (ring full), %llu instants", &written,
+                        &dropped, &incomplete),
+            3)
+      << log;
+  EXPECT_EQ(rd.frame_count(), written);
+  EXPECT_GE(written, 1u);
+  EXPECT_GE(written + dropped + incomplete, 60u) << "60 cycles ran while recording\n" << log;
+  EXPECT_EQ(rd.sensor_count(), 2u);
+  EXPECT_DOUBLE_EQ(rd.info().rig.finger_separation_mm, 62.5);
+  EXPECT_GT(rd.info().rig.pixel_pitch_mm, 0.0);
+  recording::Image img;
+  EXPECT_TRUE(rd.read_image(0, 0, &img).ok());
+
+  EXPECT_EQ(stop_daemon(), 0) << read_all(log_);
+}
+#endif
 
 TEST_F(HostCommands, BadInputFromAPeerThatVanishesIsSaidOnceAndHarmsNothing) {
   auto ch = connect();

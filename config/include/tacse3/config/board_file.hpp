@@ -99,6 +99,12 @@ struct RealtimeConfig {
   int dsp_priority = 80;  // SCHED_FIFO priority, 0 = normal scheduling
 };
 
+// [record]: where the START_RECORDING command writes (docs/can-protocol.md). Empty: the
+// command is refused (NO_RECORD_DIR).
+struct RecordBoardConfig {
+  std::string dir;  // absolute path of an existing directory
+};
+
 struct BoardConfig {
   int version = kBoardVersion;
   std::string name;
@@ -109,6 +115,7 @@ struct BoardConfig {
   CanBoardConfig can;
   GpioBoardConfig gpio;
   RealtimeConfig realtime;
+  RecordBoardConfig record;
   std::string origin;  // the file it came from
 
   bool uses_backend(CameraBackend b) const noexcept {

@@ -29,6 +29,7 @@ class GpioController;
 namespace tacse3::firmware {
 
 class FrameRecorder;
+struct RecorderConfig;
 
 // Where the calibration came from: built-in defaults or a file (reloaded on SIGHUP).
 struct CalibrationSource {
@@ -105,6 +106,9 @@ class Daemon {
   void check_can_log();
   void report_can_socket();
   void finish_summary();
+  RecorderConfig recorder_config(double finger_separation_m) const;
+  void service_recording();
+  void close_recording();
   void say(int level, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
 
   config::BoardConfig board_;
@@ -129,7 +133,10 @@ class Daemon {
   std::unique_ptr<std::array<FrameRing, 2>> rings_;
   std::unique_ptr<std::array<CommandRing, 2>> command_rings_;  // [0] CAN RX, [1] local
   std::unique_ptr<Engine> engine_;
-  std::unique_ptr<FrameRecorder> recorder_;  // --record (null: not recording)
+  // The recording being written (--record or START_RECORDING; null: none), owned here and lent
+  // to the DSP thread; housekeeping creates and closes it.
+  std::unique_ptr<FrameRecorder> recorder_;
+  std::string recording_path_;
   bool recording_failure_reported_ = false;
   SharedState shared_;
   std::atomic<bool> stop_{false};

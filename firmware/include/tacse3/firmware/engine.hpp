@@ -12,6 +12,7 @@
 #include "tacse3/firmware/health.hpp"
 #include "tacse3/firmware/latency.hpp"
 #include "tacse3/firmware/pairing.hpp"
+#include "tacse3/firmware/recording_mailbox.hpp"
 #include "tacse3/hal/camera.hpp"
 #include "tacse3/hal/camera/spsc_ring.hpp"
 #include "tacse3/hal/can/channel.hpp"
@@ -51,6 +52,7 @@ struct SharedState {
   std::array<dsp::Calibration, 2> calibration{};
   std::atomic<bool> calibration_invalid{false};  // the last reload failed (status fault code)
   std::atomic<bool> calibrated{false};  // daemon: a fitted calibration runs (Status Calibrated)
+  RecordingMailbox recording;           // START/STOP_RECORDING: DSP thread <-> housekeeping
 };
 
 struct EngineConfig {
@@ -96,7 +98,8 @@ class Engine {
 
   void start(std::int64_t now_ns) noexcept;
   // --record: every processed instant also goes to the recorder (null: not recording). Set
-  // before the DSP thread starts.
+  // before the DSP thread starts; START/STOP_RECORDING change it later (through
+  // SharedState::recording).
   void set_recorder(FrameRecorder* recorder) noexcept { recorder_ = recorder; }
   // One loop iteration at now_ns (CLOCK_MONOTONIC). Returns true when it did work (the caller
   // sleeps briefly when it did not).
@@ -123,6 +126,8 @@ class Engine {
   void release_head(std::size_t s) noexcept;
   void process(bool use_left, bool use_right, std::int64_t now_ns) noexcept;
   void handle_command(const protocol::CommandResult& r) noexcept;
+  bool recording_command(const protocol::Command& c, protocol::Ack& ack) noexcept;
+  bool finish_recording_start() noexcept;
   void tare_and_reset_pose() noexcept;
   bool apply(const protocol::Command& c) noexcept;
   void apply_pending_calibration() noexcept;
@@ -171,6 +176,7 @@ class Engine {
   std::array<bool, 2> slip_{};
   EngineStats stats_{};
   FrameRecorder* recorder_ = nullptr;
+  protocol::Ack recording_ack_{};  // the START_RECORDING answer waiting for housekeeping
 };
 
 // The dsp proxy a protocol mode maps to: AUTO is the pipeline's own kAuto when dsp has one,

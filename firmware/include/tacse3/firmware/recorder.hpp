@@ -10,6 +10,7 @@
 #include <string>
 
 #include "tacse3/dsp/types.hpp"
+#include "tacse3/protocol/types.hpp"
 #include "tacse3/recording/stream_writer.hpp"
 
 namespace tacse3::firmware {
@@ -55,5 +56,18 @@ class FrameRecorder {
   std::array<std::unique_ptr<std::uint8_t[]>, 2> grey_;  // conversion buffers, width x height
   std::uint64_t incomplete_ = 0;
 };
+
+// The directory of recording `number` under the record root: rec-NNNNN (five digits).
+std::filesystem::path numbered_recording_dir(const std::filesystem::path& root,
+                                             std::uint16_t number);
+
+// START_RECORDING's disk work (housekeeping thread): a new recording rec-NNNNN under `root`
+// (the board file's [record] dir) with `config` (its rig block as given). Returns kAck and
+// *out, or the NACK reason with *message for the log: kNoRecordDir (root empty),
+// kRecordingExists (never overwritten), kDiskError (root missing, not writable, ...).
+protocol::AckCode start_numbered_recording(const std::string& root, std::uint16_t number,
+                                           const RecorderConfig& config,
+                                           std::unique_ptr<FrameRecorder>* out,
+                                           std::string* message);
 
 }  // namespace tacse3::firmware
