@@ -336,7 +336,7 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
     d->recorder_ = FrameRecorder::start(options.record_dir,
                                         d->recorder_config(board.pipeline.finger_separation_m), &e);
     if (!d->recorder_) {
-      *error = e;
+      *error = std::string("--record ").append(e);
       return nullptr;
     }
     d->engine_->set_recorder(d->recorder_.get());

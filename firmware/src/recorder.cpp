@@ -25,7 +25,7 @@ std::unique_ptr<FrameRecorder> FrameRecorder::start(const std::filesystem::path&
     all_rgb = all_rgb && config.formats[s] == dsp::PixelFormat::kRgb888;
   }
   if (o.info.sensors.empty()) {
-    *error = "--record " + dir.string() + ": the board has no sensor";
+    *error = dir.string() + ": the board has no sensor";
     return nullptr;
   }
   r->channels_ = all_rgb ? 3 : 1;
@@ -41,7 +41,7 @@ std::unique_ptr<FrameRecorder> FrameRecorder::start(const std::filesystem::path&
   }
   auto w = recording::StreamWriter::start(dir, o);
   if (!w) {
-    *error = "--record " + dir.string() + ": " + w.status().message();
+    *error = dir.string() + ": " + w.status().message();
     return nullptr;
   }
   r->writer_ = std::move(w).value();

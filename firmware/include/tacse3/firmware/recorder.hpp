@@ -35,6 +35,7 @@ struct RecorderConfig {
 // full ring drops the frame (counted) and a write error stops the recording, never the stream.
 class FrameRecorder {
  public:
+  // *error names `dir` and the cause.
   static std::unique_ptr<FrameRecorder> start(const std::filesystem::path& dir,
                                               const RecorderConfig& config, std::string* error);
   // Frames of one instant (null for a pad without a frame at this instant).
