@@ -191,7 +191,7 @@ def cmd_commands(a):
         seq, command, result = e.split(":")
         got = by_seq.get(int(seq), [])
         desc = ", ".join(f"{k['command']} {k['result']}" for k in got) or "no Ack"
-        # canmon names known codes ("TARE") and prints unknown ones as numbers (9).
+        # canmon names known codes ("TARE") and prints unknown ones as numbers (10).
         ok(len(got) == 1 and str(got[0]["command"]) == command and got[0]["result"] == result,
            f"command seq {seq}: {desc} (want exactly one {command} {result})")
     for seq in a.ignored:

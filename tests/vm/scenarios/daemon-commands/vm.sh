@@ -18,7 +18,7 @@ send 1 "$(tacse3_cmd 030 1 01 00 00 00 00 1)"            # TARE -> ACK
 send 2 "$(tacse3_cmd 030 1 02 00 00 00 00 2)"            # RESET_POSE -> ACK
 send 3 "$(tacse3_cmd 030 1 03 A0 0F 00 00 3)"            # SET_FINGER_SEPARATION 0.04000 m -> ACK
 send 4 "$(tacse3_cmd 030 1 07 02 00 00 00 4)"            # QUERY FINGER_SEPARATION -> ACK, 4000
-send 5 "$(tacse3_cmd 030 1 09 00 00 00 00 5)"            # unknown code 0x09 -> NACK UNKNOWN_COMMAND
+send 5 "$(tacse3_cmd 030 1 0A 00 00 00 00 5)"            # unknown code 0x0A -> NACK UNKNOWN_COMMAND
 good=$(tacse3_cmd 030 1 01 00 00 00 00 6)
 send 6 "${good%??}$(printf '%02X' $(( (0x${good#"${good%??}"}) ^ 0x55 )))"   # TARE, CRC wrong -> BAD_CRC
 send 7 "$(tacse3_cmd 030 1 01 00 00 00 00 7 | cut -c1-18)"   # TARE, 7 bytes -> NACK BAD_LENGTH
