@@ -228,6 +228,40 @@ class Reader {
     *out = m;
   }
 
+  // A pose [x, y, z, qw, qx, qy, qz]: 7 finite numbers, the quaternion unit within
+  // kBoardUnitQuaternionTolerance (then normalised).
+  void pose(const toml::table& t, const char* key, const std::string& path,
+            std::array<double, 7>* out) {
+    const toml::node* n = t.get(key);
+    if (n == nullptr || !ok()) return;
+    const std::string name = "key \"" + join(path, key) + "\" ";
+    const auto* a = n->as_array();
+    if (a == nullptr || a->size() != 7) {
+      fail(n, name + "must be [x, y, z, qw, qx, qy, qz] (metres, unit quaternion), got " +
+                  (a ? std::to_string(a->size()) + " elements" : type_name(*n)));
+      return;
+    }
+    std::array<double, 7> v{};
+    for (std::size_t i = 0; i < 7; ++i) {
+      const toml::node* e = a->get(i);
+      v[i] = e != nullptr && (e->is_floating_point() || e->is_integer())
+                 ? e->value<double>().value_or(kNaN)
+                 : kNaN;
+      if (!std::isfinite(v[i])) {
+        fail(n, name + "element " + std::to_string(i) + " must be a finite number");
+        return;
+      }
+    }
+    const double norm = std::sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5] + v[6] * v[6]);
+    if (std::abs(norm - 1.0) > kBoardUnitQuaternionTolerance) {
+      fail(n, name + "quaternion (qw, qx, qy, qz) is not unit (norm " + num(norm) + ", tolerance " +
+                  num(kBoardUnitQuaternionTolerance) + ")");
+      return;
+    }
+    for (std::size_t i = 3; i < 7; ++i) v[i] /= norm;
+    *out = v;
+  }
+
  private:
   std::string origin_;
   std::string error_;
@@ -346,7 +380,7 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
   }
   rd.only_keys(root, "",
                {"version", "name", "description", "sensors", "sim", "pipeline", "can", "gpio",
-                "realtime", "record"});
+                "realtime", "record", "rig"});
   rd.string(root, "name", "", &b.name);
   rd.string(root, "description", "", &b.description);
 
@@ -467,6 +501,12 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
       rd.fail(t->get("dir"),
               "key \"record.dir\" must be an absolute path, got \"" + b.record.dir + "\"");
     }
+  }
+
+  if (const toml::table* t = rd.table(root, "rig", "")) {
+    rd.only_keys(*t, "rig", {"tcp_to_grasp"});
+    b.rig.has_tcp_to_grasp = t->get("tcp_to_grasp") != nullptr;
+    rd.pose(*t, "tcp_to_grasp", "rig", &b.rig.tcp_to_grasp);
   }
 
   if (!rd.ok()) {

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -288,4 +289,47 @@ TEST(Board, RecordDirIsAnAbsolutePath) {
   EXPECT_NE(typo.find("unknown key \"record.directory\""), std::string::npos) << typo;
   const std::string type = error_of(std::string(kMinimal) + "[record]\ndir = 1\n");
   EXPECT_NE(type.find("key \"record.dir\" must be a string"), std::string::npos) << type;
+}
+
+// [rig] tcp_to_grasp: a pose read with its quaternion normalised; absent means not given.
+TEST(Board, RigTcpToGraspIsReadAndNormalised) {
+  BoardConfig b;
+  std::string e;
+  ASSERT_TRUE(parse_board(kMinimal, "test.toml", &b, &e)) << e;
+  EXPECT_FALSE(b.rig.has_tcp_to_grasp);
+  ASSERT_TRUE(parse_board(
+      std::string(kMinimal) + "[rig]\ntcp_to_grasp = [0.01, -0.02, 0.16, 0.7075, 0, 0, 0.7075]\n",
+      "test.toml", &b, &e))
+      << e;
+  ASSERT_TRUE(b.rig.has_tcp_to_grasp);
+  EXPECT_DOUBLE_EQ(b.rig.tcp_to_grasp[0], 0.01);
+  EXPECT_DOUBLE_EQ(b.rig.tcp_to_grasp[1], -0.02);
+  EXPECT_DOUBLE_EQ(b.rig.tcp_to_grasp[2], 0.16);
+  // Norm 1.00056 (within 1e-3): normalised to cos(45 deg), sin(45 deg) about z.
+  EXPECT_NEAR(b.rig.tcp_to_grasp[3], std::sqrt(0.5), 1e-12);
+  EXPECT_NEAR(b.rig.tcp_to_grasp[6], std::sqrt(0.5), 1e-12);
+  EXPECT_EQ(b.rig.tcp_to_grasp[4], 0.0);
+}
+
+TEST(Board, BadRigTcpToGraspIsNamed) {
+  const std::string rig = std::string(kMinimal) + "[rig]\ntcp_to_grasp = ";
+  const std::string norm = error_of(rig + "[0, 0, 0.1, 1, 0, 0.1, 0]\n");
+  EXPECT_NE(norm.find("test.toml:5: key \"rig.tcp_to_grasp\" quaternion (qw, qx, qy, qz) is not "
+                      "unit (norm 1.00499"),
+            std::string::npos)
+      << norm;
+  const std::string six = error_of(rig + "[0, 0, 0, 1, 0, 0]\n");
+  EXPECT_NE(six.find("key \"rig.tcp_to_grasp\" must be [x, y, z, qw, qx, qy, qz] (metres, unit "
+                     "quaternion), got 6 elements"),
+            std::string::npos)
+      << six;
+  const std::string inf = error_of(rig + "[0, inf, 0, 1, 0, 0, 0]\n");
+  EXPECT_NE(inf.find("key \"rig.tcp_to_grasp\" element 1 must be a finite number"),
+            std::string::npos)
+      << inf;
+  const std::string str = error_of(rig + "[0, \"a\", 0, 1, 0, 0, 0]\n");
+  EXPECT_NE(str.find("element 1 must be a finite number"), std::string::npos) << str;
+  const std::string key = error_of(std::string(kMinimal) + "[rig]\ntcp = 1\n");
+  EXPECT_NE(key.find("unknown key \"rig.tcp\" (allowed here: tcp_to_grasp)"), std::string::npos)
+      << key;
 }

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "tacse3/config/board_file.hpp"
+#include "tacse3/config/calibration_file.hpp"
 #include "tacse3/fileio/file_io.hpp"
 #include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/progress.hpp"
@@ -68,7 +70,7 @@ std::string pipeline_speed(tt::RecordingSource& source, bool progress, std::vect
 
 struct Options {
   std::string rec_dir, gripper_log, object_log, tcp_to_grasp, gripper_pose, clock_offset;
-  std::string can_log, out;
+  std::string can_log, out, board;
   bool force = false, quiet = false;
 };
 
@@ -143,6 +145,7 @@ std::string usage_problem(const Options& o, tr::Rig* rig) {
       return "--tcp-to-grasp: " + e;
     }
   }
+
   if (!o.gripper_pose.empty()) {
     if (!o.gripper_log.empty()) {
       return "--gripper-pose is the pose of a still gripper: give it or --gripper-log, not both";
@@ -170,9 +173,39 @@ void print_summary(const fs::path& out, const std::vector<tacse3::recording::Tru
       out.c_str(), rows.size(), max_deg, max_mm);
 }
 
+// The TCP-to-grasp pose from the board file's [rig] tcp_to_grasp when the command line gives none;
+// *source says which was used. "" or the error naming the file and key.
+std::string board_tcp_to_grasp(const Options& o, tr::Rig* rig, std::string* source) {
+  if (!o.tcp_to_grasp.empty()) {
+    *source = "--tcp-to-grasp";
+    return {};
+  }
+  *source = "identity (no --tcp-to-grasp, no --board)";
+  if (o.board.empty()) return {};
+  namespace cfg = tacse3::config;
+  std::string err;
+  const fs::path file =
+      cfg::resolve_board(o.board, cfg::executable_dir(), TACSE3_SOURCE_BOARDS_DIR, &err);
+  if (file.empty()) return "--board: " + err;
+  cfg::BoardConfig board;
+  if (!cfg::load_board(file, &board, &err)) return err;
+  if (!board.rig.has_tcp_to_grasp) {
+    return file.string() +
+           ": no key \"rig.tcp_to_grasp\"; add [rig] tcp_to_grasp = [x, y, z, "
+           "qw, qx, qy, qz] or give --tcp-to-grasp";
+  }
+  const auto& v = board.rig.tcp_to_grasp;
+  rig->tcp_to_grasp.p = Eigen::Vector3d(v[0], v[1], v[2]);
+  rig->tcp_to_grasp.q = Eigen::Quaterniond(v[3], v[4], v[5], v[6]);
+  *source = file.string() + " [rig] tcp_to_grasp";
+  return {};
+}
+
 int execute(const Options& o) {
   tr::Rig rig;
   if (std::string e = usage_problem(o, &rig); !e.empty()) return usage(e);
+  std::string tcp_source;
+  if (std::string e = board_tcp_to_grasp(o, &rig, &tcp_source); !e.empty()) return fail(e);
   const fs::path out = o.out.empty() ? fs::path(o.rec_dir) / "truth.csv" : fs::path(o.out);
   std::string err;
   if (fs::exists(fs::symlink_status(out)) && !o.force) {
@@ -202,7 +235,10 @@ int execute(const Options& o) {
     return fail(err);
   }
   if (!tacse3::fileio::write_file_atomically(out, tr::truth_csv(rows), &err)) return fail(err);
-  if (!o.quiet) print_summary(out, rows, offset_ns, how);
+  if (!o.quiet) {
+    std::printf("tacse3-truth: TCP to grasp from %s\n", tcp_source.c_str());
+    print_summary(out, rows, offset_ns, how);
+  }
   return 0;
 }
 
@@ -222,7 +258,12 @@ int run(int argc, char** argv) {
                  "CSV: the object's pose in the world over time (gripper fixed)")
       ->check(path);
   app.add_option("--tcp-to-grasp", o.tcp_to_grasp,
-                 "\"x y z qw qx qy qz\": the grasp frame G in the TCP frame (default identity)");
+                 "\"x y z qw qx qy qz\": the grasp frame G in the TCP frame (default: --board's "
+                 "[rig] tcp_to_grasp, else identity)");
+  app.add_option("--board", o.board,
+                 "board NAME|PATH whose [rig] tcp_to_grasp gives the pose when --tcp-to-grasp "
+                 "is not given")
+      ->check(path);
   app.add_option("--gripper-pose", o.gripper_pose,
                  "\"x y z qw qx qy qz\": the fixed TCP pose in the world when there is no "
                  "--gripper-log (default identity)");

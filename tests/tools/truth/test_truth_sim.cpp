@@ -148,6 +148,56 @@ TEST_F(TruthSim, NoiselessLogRebuildsTheTruthExactly) {
   fs::remove(dir_ / "rz" / "truth.csv");
 }
 
+// A board file holding `tcp_to_grasp_line` under [rig] (empty: no [rig] table).
+fs::path write_board(const fs::path& file, const std::string& tcp_to_grasp_line) {
+  std::ofstream o(file);
+  o << "version = 1\n[sensors.left]\nbackend = \"sim\"\n";
+  if (!tcp_to_grasp_line.empty()) o << "[rig]\ntcp_to_grasp = " << tcp_to_grasp_line << "\n";
+  return file;
+}
+
+// "x y z qw qx qy qz" as a TOML array.
+std::string toml_pose(std::string text) {
+  for (std::size_t k = text.find(' '); k != std::string::npos; k = text.find(' ', k + 2)) {
+    text.replace(k, 1, ", ");
+  }
+  return "[" + text + "]";
+}
+
+// --board's [rig] tcp_to_grasp stands in for --tcp-to-grasp, which wins when both are given; the
+// summary says which was used. Noiseless log: the rebuilt truth is exact either way.
+TEST_F(TruthSim, BoardFileGivesTheTcpToGrasp) {
+  RigLog rig(7, 0.0);
+  const fs::path log = dir_ / "rz-board.csv";
+  ASSERT_EQ(rig.write_gripper_log(truth_[0], t_ns_[0], kOffsetNs, log, false), "");
+  const fs::path good = write_board(dir_ / "good.toml", toml_pose(rig.tcp_to_grasp_text()));
+  const fs::path other = write_board(dir_ / "other.toml", "[0, 0, 0.2, 1, 0, 0, 0]");
+  const std::string args = "--recording " + (dir_ / "rz").string() + " --gripper-log " +
+                           log.string() + " --clock-offset 6.437251";
+  const ToolRun from_board = run_tool(args + " --board " + good.string());
+  ASSERT_EQ(from_board.rc, 0) << from_board.out;
+  EXPECT_NE(from_board.out.find("TCP to grasp from " + good.string() + " [rig] tcp_to_grasp"),
+            std::string::npos)
+      << from_board.out;
+  Difference d = truth_difference(dir_ / "rz", truth_[0]);
+  EXPECT_LT(d.max_deg, 0.002);
+  EXPECT_LT(d.max_mm, 0.001);
+  fs::remove(dir_ / "rz" / "truth.csv");
+  const ToolRun both = run_tool(args + " --board " + other.string() + " --tcp-to-grasp \"" +
+                                rig.tcp_to_grasp_text() + "\"");
+  ASSERT_EQ(both.rc, 0) << both.out;
+  EXPECT_NE(both.out.find("TCP to grasp from --tcp-to-grasp"), std::string::npos) << both.out;
+  d = truth_difference(dir_ / "rz", truth_[0]);
+  EXPECT_LT(d.max_deg, 0.002);
+  EXPECT_LT(d.max_mm, 0.001);
+  fs::remove(dir_ / "rz" / "truth.csv");
+  // The other board's pose is not the rig's: the same run with it is off by centimetres.
+  ASSERT_EQ(run_tool(args + " --board " + other.string()).rc, 0);
+  d = truth_difference(dir_ / "rz", truth_[0]);
+  EXPECT_GT(d.max_mm, 1.0);
+  fs::remove(dir_ / "rz" / "truth.csv");
+}
+
 TEST_F(TruthSim, ExplicitOffsetRebuildsTheTruth) {
   for (std::size_t k = 0; k < truth_.size(); ++k) {
     const std::string name = tacse3::tools::truth_test::cases()[k].motion;
@@ -325,6 +375,15 @@ TEST_F(TruthSim, BadInputIsRefusedAndWritesNothing) {
   expect_refused(d, g + " --clock-offset 0 --can-log x.log", 2, "give one");
   expect_refused(d, g + " --clock-offset soon", 2, "--clock-offset: expected seconds or auto");
   expect_refused(d, g + " --clock-offset 0 --tcp-to-grasp \"0 0 0 1 0 0\"", 2, "--tcp-to-grasp");
+  // A board file whose [rig] tcp_to_grasp is not a pose, or that has none.
+  const fs::path bad = write_board(dir_ / "bad-board.toml", "[0, 0, 0.16, 0.9, 0, 0, 0]");
+  expect_refused(d, g + " --clock-offset 6.437251 --board " + bad.string(), 1,
+                 bad.string() +
+                     ":5: key \"rig.tcp_to_grasp\" quaternion (qw, qx, qy, qz) is not "
+                     "unit (norm 0.9");
+  const fs::path none = write_board(dir_ / "none-board.toml", "");
+  expect_refused(d, g + " --clock-offset 6.437251 --board " + none.string(), 1,
+                 none.string() + ": no key \"rig.tcp_to_grasp\"");
   // An existing output is kept.
   const fs::path existing = dir_ / "bad-existing.csv";
   { std::ofstream(existing) << "keep\n"; }

@@ -99,6 +99,17 @@ struct RealtimeConfig {
   int dsp_priority = 80;  // SCHED_FIFO priority, 0 = normal scheduling
 };
 
+// A quaternion in the board file is accepted as unit when its norm is within this of 1, as in
+// truth.csv (docs/recording-format.md); it is then normalised.
+inline constexpr double kBoardUnitQuaternionTolerance = 1e-3;
+
+// [rig]: the robot the board is mounted on, read by the host tools (tacse3-truth), not the daemon.
+struct RigBoardConfig {
+  // The pose of the grasp frame G in the robot's TCP frame: x, y, z (m), qw, qx, qy, qz (unit).
+  bool has_tcp_to_grasp = false;  // the key is present
+  std::array<double, 7> tcp_to_grasp{0, 0, 0, 1, 0, 0, 0};
+};
+
 // [record]: where the START_RECORDING command writes (docs/can-protocol.md). Empty: the
 // command is refused (NO_RECORD_DIR).
 struct RecordBoardConfig {
@@ -116,6 +127,7 @@ struct BoardConfig {
   GpioBoardConfig gpio;
   RealtimeConfig realtime;
   RecordBoardConfig record;
+  RigBoardConfig rig;
   std::string origin;  // the file it came from
 
   bool uses_backend(CameraBackend b) const noexcept {
