@@ -21,18 +21,47 @@ check() {  # check NAME CONDITION...
 }
 contains() { grep -q -- "$2" "$1"; }  # a basic regular expression
 
-# A set that covers every rule: slides about x and y and along x and y, a stick torsion; each
-# starts with the pads open (0.05 s), closes in 0.2 s, settles 0.05 s and holds 0.2 s.
+# The set: one recording per line of --plan's CSV (axis, magnitude, regime and motion duration
+# as planned; the pads open for 0.05 s, close in 0.2 s, settle 0.05 s and hold 0.2 s, shorter
+# than planned to keep the test short). Named by axis and magnitude: rx20 ... tx0.5.
+"$CAL" --plan --format csv > "plan.csv"
+check "--plan csv: exit 0" test $? -eq 0
+check "--plan csv: the header" test "$(head -n 1 plan.csv)" = \
+  "axis,magnitude,unit,regime,duration_s,pads_open_s,hold_s,determines"
 short="--colour grey --approach-s 0.05 --grasp-s 0.2 --settle-s 0.05 --hold-s 0.2 -j 1 -q"
-for m in "rx 20" "ry 20" "rz 3" "tx 3" "ty 3"; do
-  set -- $m
-  "$SIM" $short --out "$1$2" --object sphere --motion "$1" --magnitude "$2" ||
-    { echo "FAIL tacse3-sim $m"; exit 1; }
+set --
+while IFS=, read -r axis mag unit regime dur rest; do
+  [ "$axis" = "axis" ] && continue
+  "$SIM" $short --out "$axis$mag" --object sphere --motion "$axis" --magnitude "$mag" \
+    --regime "$regime" --motion-s "$dur" || { echo "FAIL tacse3-sim $axis $mag"; exit 1; }
+  set -- "$@" "$axis$mag"
+done < "plan.csv"
+check "--plan: six motions" test $# -eq 6
+plan_set="$*"
+
+# The plan without any one line is refused before the fit, naming what to record; nothing is
+# written.
+for drop in $plan_set; do
+  rest=""
+  for r in $plan_set; do [ "$r" = "$drop" ] || rest="$rest $r"; done
+  # shellcheck disable=SC2086
+  "$CAL" $rest -q --out "drop.toml" > /dev/null 2> "e0"
+  check "plan without $drop: exit 1" test $? -eq 1
+  case "$drop" in
+    rx*) what="a rotation about x" ;;
+    ry*) what="a rotation about y" ;;
+    rz*) what="a rotation about z" ;;
+    tx0.5) what="a translation along x or y of 0.2-1.0 mm without rotation" ;;
+    tx*) what="a translation along x of 1 mm" ;;
+    ty*) what="a translation along y of 1 mm" ;;
+  esac
+  check "plan without $drop: refused" contains "e0" "error: refused: the recordings do not determine"
+  check "plan without $drop: names $what" contains "e0" "^  record $what"
+  check "plan without $drop: no file" test ! -e "drop.toml"
 done
-set -- "rx20" "ry20" "rz3" "tx3" "ty3"
 
 # Only translations: refused before the fit, naming the three missing rotations.
-"$CAL" "tx3" "ty3" -q --out "tr.toml" > /dev/null 2> "e1"
+"$CAL" "tx10" "ty10" "tx0.5" -q --out "tr.toml" > /dev/null 2> "e1"
 check "only translations: exit 1" test $? -eq 1
 for ax in x y z; do
   check "only translations: names the rotation about $ax" contains "e1" "record a rotation about $ax"
@@ -67,17 +96,17 @@ check "mid-contact: no file" test ! -e "mid.toml"
 # --check: the committed simulator calibration explains these recordings; the same with its
 # joint-fusion rotation and translation scales tripled reads every motion three times over and
 # explains none of them.
-"$CAL" --check "$COMMITTED" "rx20" "tx3" > "o3" 2> "e3"
+"$CAL" --check "$COMMITTED" "rx20" "tx10" > "o3" 2> "e3"
 check "--check committed: exit 0" test $? -eq 0
 check "--check committed: the report" contains "o3" "check: 2 of 2 recording(s) explained"
 sed -e 's/^rotation_scale = \[1.097, 1.097, 0.8305\]/rotation_scale = [3.291, 3.291, 2.4915]/' \
   -e 's/^translation_scale = \[1.003, 0.9843, 1.0\]/translation_scale = [3.009, 2.9529, 3.0]/' \
   "$COMMITTED" > "x3.toml"
 check "the tripled file differs in two lines" test "$(diff "$COMMITTED" x3.toml | grep -c '^>')" -eq 2
-"$CAL" --check "x3.toml" "rx20" "tx3" > "o4" 2> "e4"
+"$CAL" --check "x3.toml" "rx20" "tx10" > "o4" 2> "e4"
 check "--check gains x3: exit 1" test $? -eq 1
 check "--check gains x3: names rx20" contains "e4" "not explained by x3.toml: rx20: rotation off by"
-check "--check gains x3: names tx3" contains "e4" "not explained by x3.toml: tx3: translation off by"
+check "--check gains x3: names tx10" contains "e4" "not explained by x3.toml: tx10: translation off by"
 "$CAL" --check "x3.toml" "rx20" --out "o.toml" > /dev/null 2>&1
 check "--check with --out: usage error 2" test $? -eq 2
 "$CAL" "rx20" > /dev/null 2>&1
@@ -88,7 +117,9 @@ check "neither --out nor --check: usage error 2" test $? -eq 2
 # nothing and names every FAILED row's recording.
 "$CAL" "$@" --out "fit.toml" > "o5" 2> "e5"
 rc=$?
-check "fit: a check row per recording" test "$(grep -c '^  .*  \(ok\|FAILED\)$' "o5")" -eq 5
+check "fit: a check row per recording" test "$(grep -c '^  .*  \(ok\|FAILED\)$' "o5")" -eq 6
+check "fit: the plan's set covers every rule" test "$(grep -c 'do not determine' "e5")" -eq 0
+check "fit: reports the fitted pitch" contains "o5" "^pixel pitch: fitted 0.0[0-9]* mm/px .* from 1 stick translation(s); replaces the recordings' rig.pixel_pitch_mm 0.1 (fitted / claimed "
 failed=$(grep -c 'FAILED$' "o5")
 if [ "$failed" -eq 0 ]; then
   check "fit: explained, exit 0" test $rc -eq 0
@@ -96,7 +127,7 @@ if [ "$failed" -eq 0 ]; then
   "$CAL" --check "fit.toml" "$@" -q > /dev/null 2>&1
   check "fit: --check of the written file exits 0" test $? -eq 0
 else
-  echo "note: the fit does not explain $failed of the 5 recordings:"
+  echo "note: the fit does not explain $failed of the 6 recordings:"
   grep 'FAILED$' "o5"
   check "fit: not explained, exit 1" test $rc -eq 1
   check "fit: nothing written" test ! -e "fit.toml"
@@ -110,16 +141,16 @@ fi
 # stops at its bound, which is an error naming the field and the recording; nothing is written.
 # --force writes the file anyway, with the warnings.
 big=txbig
-cp -r "tx3" "$big"
+cp -r "tx10" "$big"
 awk -F, 'BEGIN { OFS = "," } NR > 1 { $6 = sprintf("%.12f", $6 * 20) } { print }' \
-  "tx3/truth.csv" > "$big/truth.csv"
-"$CAL" "rx20" "ry20" "rz3" "$big" "ty3" -q --out "big.toml" > /dev/null 2> "e6"
+  "tx10/truth.csv" > "$big/truth.csv"
+"$CAL" "rx20" "ry20" "rz3" "$big" "ty10" "tx0.5" -q --out "big.toml" > /dev/null 2> "e6"
 check "bound: exit 1" test $? -eq 1
 check "bound: names the field" contains "e6" "error: translation_scale x: the fit asks for"
 check "bound: names the recording" contains "e6" "driven by $big"
 check "bound: not written" contains "e6" "not written: big.toml"
 check "bound: no file" test ! -e "big.toml"
-"$CAL" "rx20" "ry20" "rz3" "$big" "ty3" -q --force --out "big.toml" > /dev/null \
+"$CAL" "rx20" "ry20" "rz3" "$big" "ty10" "tx0.5" -q --force --out "big.toml" > /dev/null \
   2> "e7"
 check "--force: exit 0" test $? -eq 0
 check "--force: file written" test -s "big.toml"

@@ -71,6 +71,7 @@ tt::MotionContent translations() {
   m.set(tt::Motion::kSlide);
   m.set(tt::Motion::kStick);
   m.set(tt::Motion::kPadsOpen);
+  m.set(tt::Motion::kStickTranslation);
   return m;
 }
 
@@ -90,6 +91,12 @@ TEST(Coverage, TheRegimeRulesWaitForTheFit) {
   for (auto k :
        {tt::Motion::kRx, tt::Motion::kRy, tt::Motion::kRz, tt::Motion::kTx, tt::Motion::kTy})
     m.set(k);
+  // The pixel pitch's rule is decided by the truth too: waived when the pitch is given.
+  const auto pitch = tt::missing_motions({m}, false);
+  ASSERT_EQ(pitch.size(), 1u);
+  EXPECT_EQ(pitch[0]->motion, tt::Motion::kStickTranslation);
+  EXPECT_TRUE(tt::missing_motions({m}, false, true).empty());
+  m.set(tt::Motion::kStickTranslation);
   EXPECT_TRUE(tt::missing_motions({m}, false).empty());
   const auto missing = tt::missing_motions({m}, true);
   ASSERT_EQ(missing.size(), 3u);  // slide, stick, pads open

@@ -2,6 +2,7 @@
 // tacse3-calibrate: fit a calibration file from recordings with truth, or check one on recordings
 // with truth (docs/calibration.md).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -10,7 +11,9 @@
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/tools/calibrate.hpp"
 #include "tacse3/tools/calibration_check.hpp"
+#include "tacse3/tools/calibration_plan.hpp"
 #include "tacse3/tools/cli.hpp"
+#include "tacse3/tools/pitch_fit.hpp"
 #include "tacse3/tools/progress.hpp"
 #include "tacse3/tools/source.hpp"
 
@@ -21,6 +24,8 @@ namespace tt = tacse3::tools;
 // Exit codes (docs/calibration.md): 0 written / explained, 1 refused, failed or an error, 2 usage.
 constexpr int kFailed = 1;
 constexpr int kUsage = 2;
+// The calibration file's range of pixel_pitch_m (dsp/calibration_fields.hpp), in mm.
+constexpr double kMinPitchMm = 0.001, kMaxPitchMm = 0.2;
 
 int fail(const std::string& msg) {
   std::fprintf(stderr, "tacse3-calibrate: error: %s\n", msg.c_str());
@@ -32,9 +37,43 @@ void warn(const std::string& msg) {
 }
 
 struct Recordings {
-  std::vector<std::unique_ptr<tt::RecordingSource>> owned;
+  std::vector<std::unique_ptr<tt::FrameSource>> owned;
   std::vector<tt::FrameSource*> sources;
 };
+
+// The pixel pitch the fit uses: the one given (pitch_mm > 0), or the one fitted from the stick
+// translations, reported on stdout. Then every source carries it.
+std::string set_pixel_pitch(double pitch_mm, int jobs, bool quiet, Recordings* rec) {
+  if (pitch_mm <= 0.0) {
+    tt::PitchFit fit;
+    if (std::string e =
+            tt::fit_pixel_pitch(rec->sources, jobs, !quiet && tt::stderr_is_tty(), &fit);
+        !e.empty()) {
+      return e;
+    }
+    if (!quiet) std::printf("%s", tt::format_pitch(fit).c_str());
+    pitch_mm = fit.pitch_mm;
+    if (!(pitch_mm >= kMinPitchMm && pitch_mm <= kMaxPitchMm)) {
+      char b[256];
+      std::snprintf(b, sizeof b,
+                    "the fitted pixel pitch %.4g mm/px is outside %g .. %g: check that the stick "
+                    "translations' truth.csv is in metres and in G, or give --pixel-pitch MM",
+                    pitch_mm, kMinPitchMm, kMaxPitchMm);
+      return b;
+    }
+  } else if (!quiet) {
+    std::printf(
+        "pixel pitch: given %.5g mm/px (--pixel-pitch); replaces the recordings' "
+        "rig.pixel_pitch_mm %.5g (given / claimed %.4f)\n",
+        pitch_mm, rec->sources.front()->info().pixel_pitch_mm,
+        pitch_mm / rec->sources.front()->info().pixel_pitch_mm);
+  }
+  for (auto& s : rec->sources) {
+    rec->owned.push_back(std::make_unique<tt::PitchOverrideSource>(*s, pitch_mm));
+    s = rec->owned.back().get();
+  }
+  return {};
+}
 
 // Opens every directory; each must carry truth.
 std::string open_recordings(const std::vector<std::string>& dirs, Recordings* out) {
@@ -72,13 +111,14 @@ int run_check(const std::string& cal_file, const std::vector<std::string>& dirs,
 }
 
 int run_fit(const std::vector<std::string>& dirs, const std::string& out_file,
-            const std::string& start_file, int jobs, bool quiet, bool force) {
+            const std::string& start_file, double pitch_mm, int jobs, bool quiet, bool force) {
   // Before the fit: a fit can take minutes, and a typo in --out must not cost them.
   if (auto s = tacse3::config::check_calibration_output(out_file); !s) {
     return fail("--out: " + s.message());
   }
   tt::CalibrateOptions opt;
   opt.jobs = jobs;
+  opt.pitch_given = pitch_mm > 0.0;
   opt.progress = !quiet && tt::stderr_is_tty();
   if (!quiet)
     opt.log = [](const std::string& m) {
@@ -97,9 +137,17 @@ int run_fit(const std::vector<std::string>& dirs, const std::string& out_file,
   // What the truth alone says is missing is refused before the fit.
   std::vector<tt::MotionContent> motions;
   for (auto* s : rec.sources) motions.push_back(tt::motion_from_truth(s->info()));
-  if (std::string m = tt::coverage_message(tt::missing_motions(motions, false)); !m.empty()) {
+  if (std::string m = tt::coverage_message(tt::missing_motions(motions, false, opt.pitch_given));
+      !m.empty()) {
     if (!force) return fail("refused: " + m + "\n(or fit anyway with --force)");
     warn(m);
+  }
+  // With --force and no stick translation the recordings' own pitch stands.
+  const bool has_stick_translation =
+      std::any_of(motions.begin(), motions.end(),
+                  [](const tt::MotionContent& m) { return m[tt::Motion::kStickTranslation]; });
+  if (opt.pitch_given || has_stick_translation) {
+    if (std::string e = set_pixel_pitch(pitch_mm, jobs, quiet, &rec); !e.empty()) return fail(e);
   }
   tt::CalibrateReport report;
   if (std::string err = tt::calibrate(rec.sources, opt, &report); !err.empty()) return fail(err);
@@ -128,6 +176,9 @@ int run(int argc, char** argv) {
       "needed.\n"
       "  tacse3-calibrate REC_DIR... --out FILE     fit, self-check, write\n"
       "  tacse3-calibrate --check CAL REC_DIR...    check CAL on recordings with truth\n"
+      "  tacse3-calibrate --plan [--format csv]     the motions to record for a fit\n"
+      "The fit also fits the pixel pitch from the stick translations (a pure translation of "
+      "0.2-1 mm), unless --pixel-pitch gives it.\n"
       "A recording is explained when it has valid frames and tacse3-replay's defaults end "
       "within the tolerance of its truth: 25 % of the motion at the pads, M = |p| + |theta| "
       "W/2 (W the finger separation), but at least one pixel pitch P; in rotation the same "
@@ -136,10 +187,19 @@ int run(int argc, char** argv) {
       "is not written), 2 usage error."};
   std::vector<std::string> dirs;
   std::string out_file, start_file, check_file;
+  std::string format = "text";
   int jobs = 2;
-  bool quiet = false, force = false;
+  double pitch_mm = 0.0;
+  bool quiet = false, force = false, plan = false;
   const CLI::Validator path = tt::non_empty_path();
-  app.add_option("REC_DIR", dirs, "recording directories with truth.csv")->required()->check(path);
+  app.add_option("REC_DIR", dirs, "recording directories with truth.csv")->check(path);
+  app.add_flag("--plan", plan,
+               "print the motions to record (axis, magnitude, regime, duration, why) and exit");
+  app.add_option("--format", format, "--plan's output: text or csv (default text)")
+      ->check(CLI::IsMember({"text", "csv"}));
+  app.add_option("--pixel-pitch", pitch_mm,
+                 "the pixel pitch in mm/px instead of fitting it from stick translations")
+      ->check(CLI::Range(kMinPitchMm, kMaxPitchMm));
   auto* out = app.add_option("--out", out_file, "calibration file to write (TOML)")->check(path);
   app.add_option("--check", check_file,
                  "evaluate this calibration on the recordings instead of fitting one")
@@ -155,9 +215,29 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   app.add_flag("-q,--quiet", quiet, "no progress bar and no report (errors still go to stderr)");
   if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
+  if (plan) {
+    if (!dirs.empty() || !out_file.empty() || !check_file.empty()) {
+      std::fprintf(stderr,
+                   "tacse3-calibrate: error: --plan takes no recordings, --out or --check\n");
+      return kUsage;
+    }
+    std::printf("%s", tt::format_plan(format == "csv").c_str());
+    return 0;
+  }
+  if (format != "text") {
+    std::fprintf(stderr, "tacse3-calibrate: error: --format is --plan's\n");
+    return kUsage;
+  }
+  if (dirs.empty()) {
+    std::fprintf(stderr,
+                 "tacse3-calibrate: error: REC_DIR is required (or --plan)\nRun with --help for "
+                 "more information.\n");
+    return kUsage;
+  }
   if (!check_file.empty()) {
-    if (!start_file.empty() || force) {
-      std::fprintf(stderr, "tacse3-calibrate: error: --check takes no --start or --force\n");
+    if (!start_file.empty() || force || pitch_mm > 0.0) {
+      std::fprintf(stderr,
+                   "tacse3-calibrate: error: --check takes no --start, --force or --pixel-pitch\n");
       return kUsage;
     }
     return run_check(check_file, dirs, jobs, quiet);
@@ -168,7 +248,7 @@ int run(int argc, char** argv) {
                  "to check one\nRun with --help for more information.\n");
     return kUsage;
   }
-  return run_fit(dirs, out_file, start_file, jobs, quiet, force);
+  return run_fit(dirs, out_file, start_file, pitch_mm, jobs, quiet, force);
 }
 
 }  // namespace

@@ -974,7 +974,8 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
     rep.motions[r].set(fit.p.mode[r] == 0 ? Motion::kSlide : Motion::kStick);
     if (rep.recordings[r].noise_sigma >= 0.0) rep.motions[r].set(Motion::kPadsOpen);
   }
-  if (std::string m = coverage_message(missing_motions(rep.motions, true)); !m.empty()) {
+  if (std::string m = coverage_message(missing_motions(rep.motions, true, opt.pitch_given));
+      !m.empty()) {
     rep.problems.push_back(m);
   }
   log("stage 4/4: self-check: the fitted calibration replayed as tacse3-replay would");

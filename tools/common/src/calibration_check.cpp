@@ -75,6 +75,7 @@ MotionContent motion_from_truth(const SourceInfo& info) {
   MotionContent c;
   if (info.truth.empty()) return c;
   const dsp::Pose first = to_pose(info.truth.front());
+  double peak_xy_mm = 0.0;
   for (const auto& s : info.truth) {
     const dsp::Pose p = to_pose(s);
     // The motion relative to the first row, in G.
@@ -85,15 +86,22 @@ MotionContent motion_from_truth(const SourceInfo& info) {
     }
     if (std::abs(tr(0)) >= kExciteTranslationMm) c.set(Motion::kTx);
     if (std::abs(tr(1)) >= kExciteTranslationMm) c.set(Motion::kTy);
+    peak_xy_mm = std::max(peak_xy_mm, tr.head<2>().norm());
+  }
+  const bool rotates = c[Motion::kRx] || c[Motion::kRy] || c[Motion::kRz];
+  const bool slides = c[Motion::kTx] || c[Motion::kTy];
+  if (!rotates && !slides && peak_xy_mm >= kPitchMinTranslationMm) {
+    c.set(Motion::kStickTranslation);
   }
   return c;
 }
 
 std::vector<const CoverageRule*> missing_motions(const std::vector<MotionContent>& recordings,
-                                                 bool fitted) {
+                                                 bool fitted, bool pitch_given) {
   std::vector<const CoverageRule*> out;
   for (const auto& rule : kCoverageRules) {
     if (!rule.from_truth && !fitted) continue;
+    if (pitch_given && rule.motion == Motion::kStickTranslation) continue;
     const bool seen = std::any_of(recordings.begin(), recordings.end(),
                                   [&](const MotionContent& m) { return m[rule.motion]; });
     if (!seen) out.push_back(&rule);

@@ -27,6 +27,7 @@ struct CalibrateOptions {
   int jobs = 1;                    // recordings processed in parallel (one thread each)
   bool progress = false;           // progress bar on stderr
   std::function<void(const std::string&)> log;  // stage messages (may be empty)
+  bool pitch_given = false;  // the user gave the pixel pitch: no stick translation needed
 };
 
 // What the fit says about one recording.
