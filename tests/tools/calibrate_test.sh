@@ -150,12 +150,16 @@ check "bound: names the field" contains "e6" "error: translation_scale x: the fi
 check "bound: names the recording" contains "e6" "driven by $big"
 check "bound: not written" contains "e6" "not written: big.toml"
 check "bound: no file" test ! -e "big.toml"
-"$CAL" "rx20" "ry20" "rz3" "$big" "ty10" "tx0.5" -q --force --out "big.toml" > /dev/null \
-  2> "e7"
+"$CAL" "rx20" "ry20" "rz3" "$big" "ty10" "tx0.5" --force --out "big.toml" > "o7" 2> "e7"
 check "--force: exit 0" test $? -eq 0
 check "--force: file written" test -s "big.toml"
 check "--force: the bound is a warning" contains "e7" "warning: translation_scale x: the fit asks for"
 check "--force: says not to install it" contains "e7" "fails its check: do not install it"
+# The file holds the pitch the report says was fitted (mm/px in the report, m in the file).
+fitted=$(sed -n 's/^pixel pitch: fitted \([0-9.e+-]*\) mm\/px .*/\1/p' "o7")
+in_file=$(sed -n 's/^pixel_pitch_m = \([0-9.e+-]*\)$/\1/p' "big.toml" | head -n 1)
+check "--force: the file holds the fitted pitch ($fitted mm, $in_file m)" \
+  awk -v a="$fitted" -v b="$in_file" 'BEGIN { d = a * 1e-3 - b; exit !(a > 0 && d * d < (1e-3 * b) ^ 2) }' 
 
 [ "$fails" -eq 0 ] || { echo "$fails check(s) failed"; exit 1; }
 echo "all calibrate checks passed"

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,6 +37,12 @@ void warn(const std::string& msg) {
   std::fprintf(stderr, "tacse3-calibrate: warning: %s\n", msg.c_str());
 }
 
+std::string fmt4(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
 struct Recordings {
   std::vector<std::unique_ptr<tt::FrameSource>> owned;
   std::vector<tt::FrameSource*> sources;
@@ -51,6 +58,8 @@ std::string set_pixel_pitch(double pitch_mm, int jobs, bool quiet, Recordings* r
         !e.empty()) {
       return e;
     }
+    // Four significant digits, as the file keeps the other fitted values.
+    fit.pitch_mm = std::strtod(fmt4(fit.pitch_mm).c_str(), nullptr);
     if (!quiet) std::printf("%s", tt::format_pitch(fit).c_str());
     pitch_mm = fit.pitch_mm;
     if (!(pitch_mm >= kMinPitchMm && pitch_mm <= kMaxPitchMm)) {

@@ -163,7 +163,7 @@ std::string fit_pixel_pitch(const std::vector<FrameSource*>& sources, int jobs, 
 std::string format_pitch(const PitchFit& fit) {
   char b[320];
   std::snprintf(b, sizeof b,
-                "pixel pitch: fitted %.5g mm/px (relative standard error %.2g %%) from %zu stick "
+                "pixel pitch: fitted %.4g mm/px (relative standard error %.2g %%) from %zu stick "
                 "translation(s); replaces the recordings' rig.pixel_pitch_mm %.5g (fitted / "
                 "claimed %.4f)\n",
                 fit.pitch_mm, 100.0 * fit.relative_se, fit.recordings.size(), fit.claimed_mm,
