@@ -2,7 +2,9 @@
 // tacse3 dsp: dual-sensor fusion of the per-sensor motion into one twist in the gripper frame G.
 #include "tacse3/dsp/fusion.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace tacse3::dsp {
 namespace {
@@ -61,7 +63,7 @@ void fuse_paper(const std::array<const SensorMotion*, 2>& s, const FusionConfig&
   if (nw > 0) {
     out.xi.head<3>() = R1 * (w / nw);
     out.rotation_valid = all_solves_valid;
-    out.confidence = rcond;
+    out.rcond = rcond;
     out.rank = rank;
   }
   if (nt > 0) {
@@ -110,7 +112,7 @@ void fuse_joint(const std::array<const SensorMotion*, 2>& s, const FusionConfig&
     opt.lambda_abs = n_total * cfg.solve_lever_floor_m * cfg.solve_lever_floor_m;
     opt.rcond_min = cfg.solve_rcond_min;
     const Solve3Result r = solve3(AtA, Atb, opt);
-    out.confidence = r.rcond;
+    out.rcond = r.rcond;
     if (nw == 2) {
       omega = (scale / nw) * r.x;
       out.rotation_valid = r.valid;
@@ -163,7 +165,92 @@ void fuse_joint(const std::array<const SensorMotion*, 2>& s, const FusionConfig&
   }
 }
 
+// In-plane Σ|r|² of a pad's points about their own centroid (r ⟂ the pad normal).
+double in_plane_inertia(const MomentSums& m) noexcept {
+  if (m.n <= 0.0) return 0.0;
+  const Eigen::Vector3d c = m.s1 / m.n;
+  const Eigen::Matrix3d s2c = m.s2 - m.n * (c * c.transpose());
+  return std::fmax(s2c.trace() - m.normal.dot(s2c * m.normal), 0.0);
+}
+
+// A pad's own rotation about its normal from its points alone (about its centroid), as a vector.
+Eigen::Vector3d own_normal_rotation(const MomentSums& g, double scale_n) noexcept {
+  if (g.n <= 0.0) return Eigen::Vector3d::Zero();
+  const MomentSums c = rigid_transform(g, Eigen::Matrix3d::Identity(), -g.s1 / g.n);
+  Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
+  add_normal_equations(c, AtA, Atb);
+  const double lever = g.normal.dot(AtA * g.normal);
+  return lever > 0.0 ? Eigen::Vector3d(g.normal * (scale_n * g.normal.dot(Atb) / lever))
+                     : Eigen::Vector3d::Zero();
+}
+
 }  // namespace
+
+FitQuality fit_quality(const SensorMotion* s1, const SensorMotion* s2, const FusionConfig& cfg,
+                       double separation_m) noexcept {
+  FitQuality q;
+  const std::array<const SensorMotion*, 2> s{s1, s2};
+  std::array<MomentSums, 2> g{};
+  std::array<Eigen::Vector3d, 2> own{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  double n = 0.0, inertia = 0.0;
+  Eigen::Vector3d s1_total = Eigen::Vector3d::Zero(), sv_total = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (!enters_rotation(s[i])) continue;
+    const SensorExtrinsics& e = cfg.extrinsics[i];
+    g[i] =
+        rigid_transform(to_metric(s[i]->moments, s[i]->proxy_scale), e.R_GS, e.p_GS(separation_m));
+    own[i] = own_normal_rotation(g[i], s[i]->rotation_scale.z());
+    n += g[i].n;
+    inertia += in_plane_inertia(g[i]);
+    s1_total += g[i].s1;
+    sv_total += g[i].sv;
+    q.min_points = q.pads == 0 ? s[i]->points : std::min(q.min_points, s[i]->points);
+    ++q.pads;
+  }
+  if (q.pads == 0 || !(n > 0.0)) return FitQuality{};
+  // The joint system about the common centroid (as fuse_joint solves it) and its solution.
+  const Eigen::Vector3d m_n = s1_total / n;
+  Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
+  double svv = 0.0, levers_n = 0.0;
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (g[i].n <= 0.0) continue;
+    add_normal_equations(rigid_transform(g[i], Eigen::Matrix3d::Identity(), -m_n), AtA, Atb);
+    svv += g[i].svv;
+    const double d = g[i].normal.dot(g[i].s1 / g[i].n - m_n);
+    levers_n += g[i].n * d * d;
+  }
+  Solve3Options opt;
+  opt.lambda_rel = cfg.solve_lambda_rel;
+  opt.lambda_abs = n * cfg.solve_lever_floor_m * cfg.solve_lever_floor_m;
+  opt.rcond_min = cfg.solve_rcond_min;
+  const Solve3Result r = solve3(AtA, Atb, opt);
+  Eigen::Vector3d w = r.x;
+  if (q.pads == 2) {
+    q.rank = 3;
+    q.rcond = r.rcond;
+    const double a = levers_n, b = inertia;  // expected eigenvalues (double, single)
+    q.rcond_expected = a > 0.0 && b > 0.0 ? std::fmin(a, b) / std::fmax(a, b) : 0.0;
+    q.disagreement_m_s = (own[0] - own[1]).dot(g[0].normal) * std::sqrt(inertia / n);
+  } else {
+    const Eigen::Vector3d nn = g[0].n > 0.0 ? g[0].normal : g[1].normal;
+    const double lever = nn.dot(AtA * nn);
+    q.rank = lever > 0.0 ? 1 : 0;
+    q.rcond = q.rcond_expected = 1.0;
+    w = lever > 0.0 ? Eigen::Vector3d(nn * (nn.dot(Atb) / (lever + r.lambda)))
+                    : Eigen::Vector3d::Zero();
+  }
+  // Residual of ṽ = t + ω × q over the tangential equations, t the mean proxy (a uniform
+  // tangential field has no moment about m_N): Σ|ṽ|² − |Σṽ|²/N − 2ωᵀAᵀb + ωᵀAᵀAω.
+  const double e = svv - sv_total.squaredNorm() / n - 2.0 * w.dot(Atb) + w.dot(AtA * w);
+  const double dof = 2.0 * n - q.rank - 2.0;
+  // Too few points to estimate it: an unknown residual counts as an infinite one.
+  q.residual_speed_m_s = dof > 0.0 && std::isfinite(e) ? std::sqrt(std::fmax(e, 0.0) / dof / n)
+                                                       : std::numeric_limits<double>::infinity();
+  if (!std::isfinite(q.disagreement_m_s)) q.disagreement_m_s = 0.0;
+  return q;
+}
 
 SensorExtrinsics left_pad_extrinsics() noexcept {
   SensorExtrinsics e;
@@ -226,6 +313,7 @@ Status fuse(const SensorMotion* s1, const SensorMotion* s2, const FusionConfig& 
   const std::uint8_t any = out.rotation_sensors | out.translation_sensors;
   out.single_sensor = any == kSensor1 || any == kSensor2;
   out.valid = out.rotation_valid && out.translation_valid;
+  out.quality = fit_quality(s1, s2, cfg, separation_m);
   return Status::kOk;
 }
 

@@ -26,7 +26,7 @@ constexpr std::int64_t kMaxZNm = (std::int64_t{1} << 24) - 1;
 
 // Σ ṽ and Σ q_a ṽ_b of one proxy over Ω (the q sums are shared by every proxy).
 struct ProxySums {
-  std::int64_t svx = 0, svy = 0, sx_vy = 0, sy_vx = 0, sz_vx = 0, sz_vy = 0;
+  std::int64_t svx = 0, svy = 0, sx_vy = 0, sy_vx = 0, sz_vx = 0, sz_vy = 0, svv = 0;
   void add(std::int64_t x, std::int64_t y, std::int64_t z, std::int64_t vx,
            std::int64_t vy) noexcept {
     svx += vx;
@@ -35,6 +35,7 @@ struct ProxySums {
     sy_vx += y * vx;
     sz_vx += z * vx;
     sz_vy += z * vy;
+    svv += vx * vx + vy * vy;
   }
   void add(const ProxySums& o) noexcept {
     svx += o.svx;
@@ -43,6 +44,7 @@ struct ProxySums {
     sy_vx += o.sy_vx;
     sz_vx += o.sz_vx;
     sz_vy += o.sz_vy;
+    svv += o.svv;
   }
   void store(ContactMoments& m) const noexcept {
     m.svx = svx;
@@ -51,6 +53,7 @@ struct ProxySums {
     m.sy_vx = sy_vx;
     m.sz_vx = sz_vx;
     m.sz_vy = sz_vy;
+    m.svv = svv;
   }
 };
 
@@ -98,6 +101,7 @@ MomentSums to_metric(const ContactMoments& m, double proxy_scale) noexcept {
   r.sqxv = Eigen::Vector3d(-static_cast<double>(m.sz_vy), static_cast<double>(m.sz_vx),
                            static_cast<double>(m.sx_vy) - static_cast<double>(m.sy_vx)) *
            (kNm * proxy_scale);
+  r.svv = static_cast<double>(m.svv) * proxy_scale * proxy_scale;
   r.normal = Eigen::Vector3d::UnitZ();
   return r;
 }
@@ -112,6 +116,7 @@ MomentSums rigid_transform(const MomentSums& m, const Eigen::Matrix3d& R,
          m.n * (p * p.transpose());
   r.sv = R * m.sv;
   r.sqxv = R * m.sqxv + p.cross(r.sv);
+  r.svv = m.svv;
   r.normal = R * m.normal;
   return r;
 }

@@ -148,6 +148,18 @@ Status validate(const DualConfig& config) noexcept {
   return Status::kOk;
 }
 
+ConfidenceConfig confidence_config(const PipelineConfig& config, const Calibration& cal) noexcept {
+  ConfidenceConfig c;
+  c.rest_speed_m_s = cal.stick_rest_speed_m_s;
+  // The matching window's width in cells, uniform: variance w²/12; the smoothing's σ².
+  const double window_cells = static_cast<double>(kFlowWindow) / kGridStride;
+  const double sigma = config.smoothing.sigma_cells;
+  c.footprint_cells = std::sqrt(sigma * sigma + window_cells * window_cells / 12.0);
+  c.catchup_frames = cal.slip_catchup_frames;
+  c.smoothing_s = cal.slip_smoothing_s;
+  return c;
+}
+
 DualPipeline::DualPipeline() noexcept {
   (void)configure(DualConfig{}, std::array<Calibration, 2>{Calibration{}, Calibration{}});
 }
@@ -165,6 +177,7 @@ Status DualPipeline::configure(const DualConfig& config,
   (void)average_.set_length(cal[0].moving_average_length);
   payback_.configure(cal[0].slip_catchup_frames);
   payback_.reset();
+  confidence_.configure(confidence_config(config.pipeline, cal[0]));
   config_ = config;
   cal_ = cal;
   integrator_.reset();
@@ -181,6 +194,7 @@ Status DualPipeline::set_calibration(const std::array<Calibration, 2>& cal) noex
     (void)average_.set_length(cal[0].moving_average_length);
   }
   payback_.configure(cal[0].slip_catchup_frames);
+  confidence_.configure(confidence_config(config_.pipeline, cal[0]));
   // Entering or leaving kAuto on either sensor: the pending payback belongs to the old mode.
   for (std::size_t i = 0; i < cal.size(); ++i) {
     if ((cal[i].velocity_proxy == VelocityProxy::kAuto) !=
@@ -267,6 +281,15 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
   if (gap) payback_.reset();
   out.paid = payback_.update(pf, dt);
 
+  // Confidence of this frame's twist: the fit's quality and the contributing pads' slip state.
+  bool slipping = false;
+  for (std::size_t i = 0; i < 2; ++i) {
+    if ((out.fused.rotation_sensors & (1u << i)) == 0) continue;
+    slipping = slipping || out.slipping[i];
+  }
+  out.confidence_terms = confidence_.update(out.fused.quality, slipping, pf.onset, dt);
+  out.confidence = out.confidence_terms.value;
+
   // Moving average (Sec. IV-D). A frame without a valid estimate contributes a zero twist: with
   // no evidence of motion the object is held still rather than extrapolated.
   out.twist = average_.push(out.paid);
@@ -280,6 +303,7 @@ void DualPipeline::tare() noexcept {
   for (auto& s : sensors_) s.tare();
   average_.reset();
   payback_.reset();
+  confidence_.reset();
 }
 
 void DualPipeline::reset_pose() noexcept {

@@ -389,7 +389,7 @@ protocol::StatusMsg Engine::status_message() const noexcept {
   m.stream_enabled = stream_enabled_;
   m.fusion = to_protocol(pipeline_.config().fusion.method);
   m.velocity_mode = velocity_mode_;
-  m.confidence = have_result_ && result_.valid ? clamp01_or_nan(result_.fused.confidence) : kNaN;
+  m.confidence = have_result_ && result_.valid ? clamp01_or_nan(result_.confidence) : kNaN;
   m.rate_divider = rate_divider_;
   m.fault = state_.fault;
   if (m.fault == FaultCode::kNone && shared_.calibration_invalid.load(std::memory_order_relaxed)) {

@@ -4,9 +4,11 @@
 // signs), single-sensor operation, bad inputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include "tacse3/dsp/contact.hpp"
 #include "tacse3/dsp/fusion.hpp"
@@ -285,7 +287,8 @@ TEST(Fusion, NoContactGivesZeroInvalid) {
       EXPECT_FALSE(f.translation_valid);
       EXPECT_FALSE(f.single_sensor);
       EXPECT_EQ(f.rotation_sensors | f.translation_sensors, 0);
-      EXPECT_EQ(f.confidence, 0.0);
+      EXPECT_EQ(f.rcond, 0.0);
+      EXPECT_EQ(f.quality.pads, 0);
     }
   }
 }
@@ -325,6 +328,79 @@ TEST(Fusion, BadSeparationOrConfigIsRejected) {
   ASSERT_EQ(fuse(&poisoned, &d.right, cfg, kW, out), Status::kOk);
   EXPECT_TRUE(out.xi.allFinite());
   EXPECT_FALSE(out.valid);
+}
+
+// rms in-plane lever of the points about their own pad's centroid (pads told apart by z).
+double rms_lever(const std::vector<dsp_ref::PointSample>& pts) {
+  double inertia = 0.0;
+  for (const double side : {1.0, -1.0}) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (const auto& p : pts) {
+      if (p.q.z() * side > 0.0) {
+        c += p.q;
+        ++n;
+      }
+    }
+    c /= n;
+    for (const auto& p : pts) {
+      if (p.q.z() * side > 0.0) inertia += (p.q - c).head<2>().squaredNorm();
+    }
+  }
+  return std::sqrt(inertia / static_cast<double>(pts.size()));
+}
+
+TEST(FitQuality, RigidMotionFitsWithoutResidualOrDisagreement) {
+  const Eigen::Vector3d omega(0.0, 0.0, 0.5);
+  const Dual d = observe(omega, Eigen::Vector3d(2e-3, -1e-3, 0.0));
+  const FitQuality q = fit_quality(&d.left, &d.right, FusionConfig{}, kW);
+  EXPECT_EQ(q.pads, 2);
+  EXPECT_EQ(q.rank, 3);
+  EXPECT_EQ(q.min_points, std::min(d.left.points, d.right.points));
+  // Flat parallel patches opposite each other: the conditioning is the expected one.
+  EXPECT_NEAR(q.rcond / q.rcond_expected, 1.0, 0.05);
+  // Speeds of a few mm/s read to the Q16 proxy's rounding.
+  const double speed = omega.norm() * rms_lever(d.points_G);
+  EXPECT_LT(q.residual_speed_m_s, 1e-3 * speed);
+  EXPECT_LT(std::abs(q.disagreement_m_s), 1e-3 * speed);
+}
+
+TEST(FitQuality, APadReadingTwiceTheTorsionDisagreesByItsSpeed) {
+  const Eigen::Vector3d omega(0.0, 0.0, 0.5);
+  Dual d = observe(omega, kZero);
+  d.right.rotation_scale.z() = 2.0;  // the right pad's own ω_n doubles; the left's stays
+  const FitQuality q = fit_quality(&d.left, &d.right, FusionConfig{}, kW);
+  // (ω_1 − ω_2)·n_1 · L = (0.5 − 1.0) · L.
+  EXPECT_NEAR(q.disagreement_m_s / (-0.5 * rms_lever(d.points_G)), 1.0, 0.02);
+}
+
+TEST(FitQuality, ANonRigidProxyLeavesItsResidual) {
+  // One pad, the proxy doubled on every point of a rigid torsion: ṽ = 2ω × r fits ω' = 2ω with
+  // no residual; adding a uniform field also fits (the translation); an alternating field does
+  // not. Built on the moments directly: Σ|ṽ|² grows by Σ|δ|² with δ ⟂ every rigid field.
+  const Dual d = observe(Eigen::Vector3d(0.0, 0.0, 0.5), kZero);
+  SensorMotion m = d.left;
+  const FitQuality rigid = fit_quality(&m, nullptr, FusionConfig{}, kW);
+  EXPECT_EQ(rigid.rank, 1);
+  EXPECT_EQ(rigid.pads, 1);
+  EXPECT_EQ(rigid.rcond, 1.0);
+  // δ of size s on every point, orthogonal to the rigid fields: Σ|δ|² = N s² raises the
+  // residual per equation by N s² / (2N − 3), so σ̂²/N by s² / (2N − 3).
+  const double s_q16 = 1000.0;
+  m.moments.svv += static_cast<std::int64_t>(m.moments.n * s_q16 * s_q16);
+  const FitQuality noisy = fit_quality(&m, nullptr, FusionConfig{}, kW);
+  const double n = static_cast<double>(m.moments.n);
+  const double s = s_q16 * m.proxy_scale;
+  const double expected =
+      std::sqrt(rigid.residual_speed_m_s * rigid.residual_speed_m_s + s * s / (2.0 * n - 3.0));
+  EXPECT_NEAR(noisy.residual_speed_m_s / expected, 1.0, 1e-6);
+}
+
+TEST(FitQuality, NoPadIsEmpty) {
+  const FitQuality q = fit_quality(nullptr, nullptr, FusionConfig{}, kW);
+  EXPECT_EQ(q.pads, 0);
+  EXPECT_EQ(q.rank, 0);
+  EXPECT_EQ(q.residual_speed_m_s, 0.0);
 }
 
 }  // namespace

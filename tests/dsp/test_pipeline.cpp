@@ -2,9 +2,12 @@
 // tacse3 tests: end-to-end dual-sensor pipeline on synthetic grasps, against truth and reference.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "support/scenes.hpp"
 #include "tacse3/dsp/pipeline.hpp"
@@ -49,6 +52,7 @@ std::array<Calibration, 2> calibration(VelocityProxy mode) {
 
 struct RunResult {
   std::vector<Vector6d> twist;
+  std::vector<double> confidence;
   Pose pose;
   int valid_frames = 0;
 };
@@ -66,6 +70,7 @@ RunResult run_fixed(const Rendered& r, const DualConfig& cfg, const std::array<C
     DualResult res;
     p->process(&l, left_only ? nullptr : &rt, static_cast<std::int64_t>(f) * period_ns, res);
     out.twist.push_back(res.twist);
+    out.confidence.push_back(res.confidence);
     out.valid_frames += res.valid ? 1 : 0;
     out.pose = res.pose;
   }
@@ -83,6 +88,7 @@ RunResult run_reference(const Rendered& r, const DualConfig& cfg,
     dsp_ref::DualResultRef res;
     p.process(&l, left_only ? nullptr : &rt, static_cast<std::int64_t>(f) * period_ns, res);
     out.twist.push_back(res.twist);
+    out.confidence.push_back(res.confidence);
     out.pose = res.pose;
   }
   return out;
@@ -139,6 +145,15 @@ const Rendered& translation_along_y() {
   return r;
 }
 
+// Median and largest |fixed − reference| of the per-frame confidence.
+std::pair<double, double> confidence_difference(const std::vector<double>& a,
+                                                const std::vector<double>& b) {
+  std::vector<double> d;
+  for (std::size_t i = 0; i < a.size(); ++i) d.push_back(std::abs(a[i] - b[i]));
+  std::sort(d.begin(), d.end());
+  return {d[d.size() / 2], d.back()};
+}
+
 double rms_omega_difference(const std::vector<Vector6d>& a, const std::vector<Vector6d>& b) {
   double sum = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) sum += (a[i].head<3>() - b[i].head<3>()).squaredNorm();
@@ -175,6 +190,13 @@ TEST_P(FixedVsReference, TwistAndFinalPoseAgree) {
       omega_snr_db(ref.twist, fx.twist), rms_omega_difference(ref.twist, fx.twist),
       (fx.pose.p - ref.pose.p).norm());
   EXPECT_LT((a - b).norm() / kDeg, 0.1 + 0.01 * b.norm() / kDeg);
+  // The confidence: the same class on the same fit, from the moments or point by point; what
+  // differs is the contact cells on the τ threshold (the area term, the residual's few points).
+  const auto [median_c, max_c] = confidence_difference(fx.confidence, ref.confidence);
+  std::printf("%s: confidence |fixed - reference| median %.4f, max %.4f\n", c.name, median_c,
+              max_c);
+  EXPECT_LT(median_c, 0.005);  // measured ≤ 0.0004 and ≤ 0.004 on these scenes
+  EXPECT_LT(max_c, 0.02);
   if (c.left_only && c.method == FusionMethod::kJoint) {
     // One pad: both read only the rotation about the pad normal (dsp/fusion.cpp).
     EXPECT_EQ(a.x(), 0.0);

@@ -2,7 +2,10 @@
 // tacse3 dsp reference: the whole dual-sensor pipeline chained from the double-precision stages.
 #include "tacse3/dsp_ref/pipeline_ref.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "tacse3/dsp/luma.hpp"
 #include "tacse3/dsp_ref/density_ref.hpp"
@@ -92,6 +95,7 @@ DualPipelineRef::DualPipelineRef(const dsp::DualConfig& config,
     : config_(config), cal_(cal), payback_(cal[0].slip_catchup_frames) {
   sensors_.emplace_back(config.pipeline, cal[0], options);
   sensors_.emplace_back(config.pipeline, cal[1], options);
+  confidence_.configure(dsp::confidence_config(config.pipeline, cal[0]));
 }
 
 void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* right,
@@ -243,6 +247,17 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
     confirmed = confirmed && m[i].stick_confirmed;
   }
   const dsp::Vector6d velocity = differs ? fuse(true, ignored) : out.fused;
+
+  // Confidence: the chosen readings' fit (dsp::fuse's rule for entering ω) and their slip state.
+  std::array<const SensorMotionRef*, 2> pads{nullptr, nullptr};
+  bool slipping = false;
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (!ok[i] || !m[i].contact || !m[i].proxy_valid || m[i].samples.empty()) continue;
+    pads[i] = &m[i];
+    slipping = slipping || m[i].slipping;
+  }
+  out.quality = fit_quality_ref(pads, fc, config_.finger_separation_m);
+  out.confidence = confidence_.update(out.quality, slipping, onset, dt).value;
   const dsp::Vector6d paid =
       payback_.update(out.fused, velocity, differs, contact, onset, confirmed, gap, dt);
 
@@ -256,6 +271,83 @@ void DualPipelineRef::process(const dsp::FrameView* left, const dsp::FrameView* 
 
   pose_ = dsp::integrate_spatial(pose_, out.twist, dt);
   out.pose = pose_;
+}
+
+dsp::FitQuality fit_quality_ref(const std::array<const SensorMotionRef*, 2>& pads,
+                                const dsp::FusionConfig& cfg, double separation_m) {
+  dsp::FitQuality q;
+  std::array<std::vector<PointSample>, 2> g;
+  std::vector<PointSample> all;
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (pads[i] == nullptr) continue;
+    const dsp::SensorExtrinsics& e = cfg.extrinsics[i];
+    for (const PointSample& ps : pads[i]->samples) {
+      PointSample p;
+      p.q = e.R_GS * ps.q + e.p_GS(separation_m);
+      p.v = e.R_GS * ps.v;
+      p.normal = e.R_GS * ps.normal;
+      g[i].push_back(p);
+      all.push_back(p);
+    }
+    q.min_points = q.pads == 0 ? pads[i]->points : std::min(q.min_points, pads[i]->points);
+    ++q.pads;
+  }
+  if (all.empty()) return dsp::FitQuality{};
+  const double n = static_cast<double>(all.size());
+  const Eigen::Vector3d m_n = centroid(all);
+  const StackedSystem sys = stack_shear_rows(shifted(all, m_n));
+  const Eigen::Matrix3d AtA = sys.A.transpose() * sys.A;
+  const double lambda = cfg.solve_lambda_rel * AtA.trace() / 3.0 +
+                        n * cfg.solve_lever_floor_m * cfg.solve_lever_floor_m;
+  // Per pad: the lever of its centroid along its normal, its in-plane Σ|r|², its own ω_n.
+  double levers_n = 0.0, inertia = 0.0;
+  std::array<Eigen::Vector3d, 2> own{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (g[i].empty()) continue;
+    const Eigen::Vector3d c = centroid(g[i]);
+    const Eigen::Vector3d nn = g[i].front().normal;
+    levers_n += static_cast<double>(g[i].size()) * std::pow(nn.dot(c - m_n), 2);
+    for (const PointSample& p : g[i]) {
+      const Eigen::Vector3d r = p.q - c;
+      inertia += (r - nn * nn.dot(r)).squaredNorm();
+    }
+    const StackedSystem own_sys = stack_shear_rows(shifted(g[i], c));
+    const Eigen::VectorXd column = own_sys.A * nn;
+    const double lever = column.squaredNorm();
+    if (lever > 0.0) own[i] = nn * (pads[i]->rotation_scale.z() * column.dot(own_sys.b) / lever);
+  }
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  if (q.pads == 2) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(AtA, Eigen::EigenvaluesOnly);
+    const Eigen::Vector3d ev = eig.eigenvalues();
+    q.rank = 3;
+    q.rcond = ev(2) > 0.0 ? std::max(ev(0), 0.0) / ev(2) : 0.0;
+    q.rcond_expected = levers_n > 0.0 && inertia > 0.0
+                           ? std::min(levers_n, inertia) / std::max(levers_n, inertia)
+                           : 0.0;
+    q.disagreement_m_s = (own[0] - own[1]).dot(g[0].front().normal) * std::sqrt(inertia / n);
+    w = solve_stacked(sys, lambda);
+  } else {
+    const Eigen::Vector3d nn = all.front().normal;
+    const Eigen::VectorXd column = sys.A * nn;
+    const double lever = column.squaredNorm();
+    q.rank = lever > 0.0 ? 1 : 0;
+    q.rcond = q.rcond_expected = 1.0;
+    if (lever > 0.0) w = nn * (column.dot(sys.b) / (lever + lambda));
+  }
+  // Residual of ṽ = t̄ + ω × q on the tangential components, t̄ the mean proxy, point by point.
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  for (const PointSample& p : all) t += p.v;
+  t /= n;
+  double e = 0.0;
+  for (const PointSample& p : all) {
+    const Eigen::Vector3d r = p.v - t - w.cross(p.q - m_n);
+    e += (r - p.normal * p.normal.dot(r)).squaredNorm();
+  }
+  const double dof = 2.0 * n - q.rank - 2.0;
+  q.residual_speed_m_s =
+      dof > 0.0 ? std::sqrt(e / dof / n) : std::numeric_limits<double>::infinity();
+  return q;
 }
 
 }  // namespace tacse3::dsp_ref

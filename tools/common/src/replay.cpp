@@ -257,7 +257,7 @@ std::string Replayer::step_views(std::array<const dsp::FrameView*, 2> views, std
   r.pose = result_.pose;
   r.estimate_valid = result_.valid;
   r.single_sensor = result_.single_sensor;
-  r.confidence = result_.fused.confidence;
+  r.confidence = result_.confidence;
   r.dt_s = result_.dt_s;
   const std::uint8_t used = result_.fused.rotation_sensors | result_.fused.translation_sensors;
   for (std::size_t k = 0; k < 2; ++k) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 
+#include "tacse3/dsp/confidence.hpp"
 #include "tacse3/dsp/motion.hpp"
 #include "tacse3/dsp/se3.hpp"
 #include "tacse3/dsp/solve3.hpp"
@@ -71,7 +72,9 @@ struct FusedMotion {
   bool valid = false;  // rotation_valid && translation_valid
   // rcond of the 3x3 normal equations (min over sensors for kPaper). kJoint with one pad: still
   // the 3x3 system's, although ω then comes from the 1-D solve about the pad normal.
-  double confidence = 0.0;
+  double rcond = 0.0;
+  // The joint fit's quality whatever the method (fit_quality()); TwistConfidence's input.
+  FitQuality quality{};
   // Observed ω directions (min over sensors for kPaper); kJoint with one pad: 1 (0 when the pad's
   // points have no lever about its normal, then ω = 0 and rotation_valid is false).
   int rank = 0;
@@ -89,5 +92,12 @@ struct FusedMotion {
 // mean_s(R_GS diag(rotation_scale_s) R_GSᵀ) to ω (identity with default scales).
 Status fuse(const SensorMotion* s1, const SensorMotion* s2, const FusionConfig& cfg,
             double separation_m, FusedMotion& out) noexcept;
+
+// The quality of the joint least squares over the pads that enter ω (fuse()'s rule), from their
+// moments in G: conditioning, residual (needs ContactMoments::svv), the pads' agreement about
+// their normals and the smaller pad's size (FitQuality). kJoint solves the same system; kPaper's
+// twist is read from the same points. No pad: all zero. Fixed work, no heap, never NaN.
+FitQuality fit_quality(const SensorMotion* s1, const SensorMotion* s2, const FusionConfig& cfg,
+                       double separation_m) noexcept;
 
 }  // namespace tacse3::dsp

@@ -22,13 +22,15 @@ inline constexpr std::int32_t kMaxProxyQ16 = (std::int32_t{1} << 23) - 1;
 // ω, paper Sec. IV-C/D), accumulated over Ω in the SENSOR frame.
 // Units: q in nm (contact.hpp), ṽ in Q16 proxy units (shear, or shear increment, per point);
 // ṽ_z = 0 (shear-only). Scaling and overflow: N ≤ 1200 < 2^11, |q_x|,|q_y| < 2^25, 0 ≤ q_z < 2^24,
-// |ṽ| < 2^23, so Σ q qᵀ < 2^61 and Σ q ṽ < 2^59: exact in int64, no saturation needed.
+// |ṽ| < 2^23, so Σ q qᵀ < 2^61, Σ q ṽ < 2^59 and Σ |ṽ|² < 2^58: exact in int64, no saturation
+// needed.
 struct ContactMoments {
   std::int64_t n = 0;
   std::int64_t sx = 0, sy = 0, sz = 0;                                // Σ q
   std::int64_t sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;  // Σ q qᵀ
   std::int64_t svx = 0, svy = 0;                                      // Σ ṽ
   std::int64_t sx_vy = 0, sy_vx = 0, sz_vx = 0, sz_vy = 0;  // Σ q_a ṽ_b used by Σ q×ṽ
+  std::int64_t svv = 0;  // Σ |ṽ|² (the fit residual, fit_quality() in fusion.hpp)
 };
 
 // The same sums in double and SI units (m, m/s), in some frame F, plus the unit normal n_F of the
@@ -39,6 +41,7 @@ struct MomentSums {
   Eigen::Matrix3d s2 = Eigen::Matrix3d::Zero();    // Σ q qᵀ
   Eigen::Vector3d sv = Eigen::Vector3d::Zero();    // Σ ṽ
   Eigen::Vector3d sqxv = Eigen::Vector3d::Zero();  // Σ q × ṽ
+  double svv = 0.0;                                // Σ |ṽ|²
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
 };
 
@@ -47,7 +50,7 @@ MomentSums to_metric(const ContactMoments& m, double proxy_scale) noexcept;
 
 // Moments of the transformed points q' = R q + p and vectors ṽ' = R ṽ (R orthonormal):
 //   Σq' = R Σq + N p,  Σq'q'ᵀ = R Σqqᵀ Rᵀ + (R Σq) pᵀ + p (R Σq)ᵀ + N p pᵀ,
-//   Σṽ' = R Σṽ,  Σ q'×ṽ' = R Σ q×ṽ + p × R Σṽ,  n' = R n.
+//   Σṽ' = R Σṽ,  Σ q'×ṽ' = R Σ q×ṽ + p × R Σṽ,  Σ|ṽ'|² = Σ|ṽ|²,  n' = R n.
 MomentSums rigid_transform(const MomentSums& m, const Eigen::Matrix3d& R,
                            const Eigen::Vector3d& p) noexcept;
 

@@ -7,6 +7,7 @@
 
 #include "tacse3/dsp/block_flow.hpp"
 #include "tacse3/dsp/calibration.hpp"
+#include "tacse3/dsp/confidence.hpp"
 #include "tacse3/dsp/contact.hpp"
 #include "tacse3/dsp/density.hpp"
 #include "tacse3/dsp/force_map.hpp"
@@ -143,7 +144,15 @@ struct DualResult {
   bool single_sensor = false;                  // only one sensor contributed
   double dt_s = 0.0;                           // integration step used
   std::array<bool, 2> slipping{false, false};  // per sensor, = sensors[k].slipping
+  // Confidence of this frame's twist in [0, 1] (TwistConfidence on fused.quality and the pads'
+  // slip state; trust it at ≥ kConfidenceThreshold), and its terms.
+  double confidence = 0.0;
+  TwistConfidence::Terms confidence_terms{};
 };
+
+// The confidence's scales for a pipeline configuration and the left pad's calibration (the one
+// whose payback the dual pipeline runs).
+ConfidenceConfig confidence_config(const PipelineConfig& config, const Calibration& cal) noexcept;
 
 // Two sensors, fusion (paper sign matrix or joint solve), moving average and SE(3) integration.
 class DualPipeline {
@@ -180,6 +189,7 @@ class DualPipeline {
   std::array<SensorPipeline, 2> sensors_{};
   MovingAverage<> average_{};
   SlipPayback payback_{};
+  TwistConfidence confidence_{};
   PoseIntegrator integrator_{};
   std::int64_t last_t_ns_ = 0;
   bool have_last_t_ = false;

@@ -90,7 +90,15 @@ struct DualResultRef {
   dsp::Vector6d twist = dsp::Vector6d::Zero();  // moving average
   dsp::Pose pose{};
   bool rotation_valid = false;
+  dsp::FitQuality quality{};  // of the chosen readings' joint fit (fit_quality_ref)
+  double confidence = 0.0;    // dsp::TwistConfidence on `quality` and the pads' slip state
 };
+
+// dsp::fit_quality from the pads' points in G directly: the stacked rows' AᵀA and eigenvalues,
+// the residual summed point by point, each pad's own 1-D fit about its normal. pads[i] null:
+// pad i does not enter ω.
+dsp::FitQuality fit_quality_ref(const std::array<const SensorMotionRef*, 2>& pads,
+                                const dsp::FusionConfig& cfg, double separation_m);
 
 // Both sensors, joint or paper fusion by brute-force stacked least squares in G, the moving
 // average as an explicit window mean and the SE(3) integration of dsp/se3 (already double).
@@ -110,6 +118,7 @@ class DualPipelineRef {
   std::vector<SensorPipelineRef> sensors_;
   std::vector<dsp::Vector6d> window_;
   SlipPaybackRef payback_;
+  dsp::TwistConfidence confidence_;
   dsp::Pose pose_{};
   std::int64_t last_t_ns_ = 0;
   bool have_last_t_ = false;
