@@ -157,6 +157,7 @@ TEST(Motion, ExtremeMomentsAreExactInInt64) {
   EXPECT_EQ(out.moments.szz, n * z * z);
   EXPECT_EQ(out.moments.sx_vy, -n * x * v);
   EXPECT_EQ(out.moments.sz_vx, n * z * v);
+  EXPECT_EQ(out.moments.svv, 2 * n * v * v);
   expect_finite(out);
 }
 

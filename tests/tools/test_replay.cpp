@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -81,6 +82,20 @@ TEST_F(ReplayTest, DisplacementProxyFollowsTheStickRotation) {
   EXPECT_LT(s.errors.final_rotation_error_deg, 6.0);
   EXPECT_LT(s.errors.final_translation_error_mm, 2.0);
   EXPECT_GT(s.valid_fraction, 0.3);
+  // The summary's confidence: the frames with a valid estimate at or above the threshold, and
+  // their median (tests/tools/test_confidence.cpp checks the values themselves).
+  std::vector<double> conf;
+  std::size_t confident = 0;
+  for (const auto& f : run.frames) {
+    if (!f.estimate_valid) continue;
+    conf.push_back(f.confidence);
+    confident += f.confidence >= dsp::kConfidenceThreshold ? 1 : 0;
+  }
+  ASSERT_FALSE(conf.empty());
+  std::sort(conf.begin(), conf.end());
+  EXPECT_DOUBLE_EQ(s.confident_fraction, static_cast<double>(confident) / run.frames.size());
+  EXPECT_DOUBLE_EQ(s.confidence_median, conf[conf.size() / 2]);
+  EXPECT_GT(s.confident_fraction, 0.0);
   // Nothing before contact: the first rows are exactly at rest.
   EXPECT_EQ(run.frames.front().twist.norm(), 0.0);
   EXPECT_FALSE(run.frames.front().valid[0]);

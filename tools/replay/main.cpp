@@ -209,6 +209,9 @@ int run(int argc, char** argv) {
                (cal_text + (opt.calibration.fitted ? "" : ": UNCALIBRATED")).c_str());
   std::fprintf(report, "  estimate valid in %.0f%% of frames; wrote %s\n",
                100.0 * sum.valid_fraction, to_stdout ? "standard output" : out_file.c_str());
+  std::fprintf(report, "  confidence >= %.1f in %.0f%% of frames (median %.2f where valid)\n",
+               tacse3::dsp::kConfidenceThreshold, 100.0 * sum.confident_fraction,
+               sum.confidence_median);
   if (sum.has_truth) {
     const auto& e = sum.errors;
     std::fprintf(report,

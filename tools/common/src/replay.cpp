@@ -324,9 +324,21 @@ RunSummary summarize(const SourceInfo& info, const std::vector<FrameResult>& fra
                      SensorChoice sensors) {
   RunSummary s;
   if (frames.empty()) return s;
-  std::int64_t valid = 0;
-  for (const auto& f : frames) valid += f.estimate_valid ? 1 : 0;
+  std::int64_t valid = 0, confident = 0;
+  std::vector<double> confidence;
+  for (const auto& f : frames) {
+    if (!f.estimate_valid) continue;
+    ++valid;
+    confident += f.confidence >= dsp::kConfidenceThreshold ? 1 : 0;
+    confidence.push_back(f.confidence);
+  }
   s.valid_fraction = static_cast<double>(valid) / static_cast<double>(frames.size());
+  s.confident_fraction = static_cast<double>(confident) / static_cast<double>(frames.size());
+  if (!confidence.empty()) {
+    const auto mid = confidence.begin() + static_cast<std::ptrdiff_t>(confidence.size() / 2);
+    std::nth_element(confidence.begin(), mid, confidence.end());
+    s.confidence_median = *mid;
+  }
   if (info.has_truth()) {
     s.has_truth = true;
     std::vector<dsp::Pose> poses;

@@ -127,6 +127,10 @@ struct RunSummary {
   bool has_slip_score = false;
   SlipScore slip{};
   double valid_fraction = 0.0;  // frames with a valid estimate
+  // Frames with a valid estimate and confidence ≥ dsp::kConfidenceThreshold, and the median
+  // confidence over the frames with a valid estimate (0 without one).
+  double confident_fraction = 0.0;
+  double confidence_median = 0.0;
 };
 RunSummary summarize(const SourceInfo& info, const std::vector<FrameResult>& frames,
                      SensorChoice sensors);
