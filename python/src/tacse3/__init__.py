@@ -18,6 +18,7 @@ from .codec import FrameError, IdLayout, crc8
 from .messages import (Ack, Command, Cycle, Status, StatusContact, StatusCounters, StatusTiming,
                        decode, encode_ack, encode_command, encode_cycle)
 from .reassembler import BusDecoder, CycleReassembler
+from .socketbus import SocketBus
 from . import table
 from .table import PROTOCOL_VERSION
 
@@ -26,7 +27,8 @@ __version__ = "0.1.0"
 __all__ = [
     "Ack", "AckTimeout", "BusDecoder", "CandumpError", "Client", "ClientError", "Command",
     "Cycle", "CycleReassembler", "FrameError", "IdLayout", "LogReader", "NackError",
-    "PROTOCOL_VERSION", "Status", "StatusContact", "StatusCounters", "StatusTiming", "crc8",
+    "PROTOCOL_VERSION", "SocketBus", "Status", "StatusContact", "StatusCounters", "StatusTiming",
+    "crc8",
     "decode", "encode_ack", "encode_command", "encode_cycle", "format_line", "parse_line",
     "table",
 ]
