@@ -88,7 +88,8 @@ def sim_board(dir_path, record_dir=None):
     """boards/sim/board.toml, looping, optionally with [record] dir: a path in dir_path."""
     source = pathlib.Path(__file__).resolve().parents[2] / "boards" / "sim" / "board.toml"
     text = source.read_text().replace("repeat = false", "repeat = true")
-    text = text.replace("stale_ms = 50", "stale_ms = 1000").replace("lost_ms = 500", "lost_ms = 2000")
+    text = text.replace("stale_ms = 50", "stale_ms = 1000")
+    text = text.replace("lost_ms = 500", "lost_ms = 2000")
     if record_dir:
         text += f'\n[record]\ndir = "{record_dir}"\n'
     board = pathlib.Path(dir_path) / "board.toml"

@@ -26,7 +26,8 @@ def board(tmp, record_dir):
     """boards/sim, looping, stale/lost raised for a loaded machine, [record] dir if given."""
     text = (pathlib.Path(SOURCE) / "boards" / "sim" / "board.toml").read_text()
     text = text.replace("repeat = false", "repeat = true")
-    text = text.replace("stale_ms = 50", "stale_ms = 1000").replace("lost_ms = 500", "lost_ms = 2000")
+    text = text.replace("stale_ms = 50", "stale_ms = 1000")
+    text = text.replace("lost_ms = 500", "lost_ms = 2000")
     if record_dir:
         text += f'\n[record]\ndir = "{record_dir}"\n'
     path = tmp / "board.toml"
