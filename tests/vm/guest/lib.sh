@@ -320,6 +320,18 @@ loopback_pads() {
   echo "ok: both loopback devices carry 320x240 frames"
 }
 
+# can_flap_scenario CYCLES: two vivid pads, vcan0, tacse3d started with ./board.toml and seen
+# sending Status, then can_flap CYCLES, then the timed SIGTERM.
+can_flap_scenario() {
+  vivid_two_sensors
+  vcan_up vcan0
+  need_daemon
+  daemon_start ./board.toml
+  timeout 30 candump -n 1 vcan0,028:7FF >/dev/null 2>&1 || fail "no Status frame within 30 s of the start"
+  can_flap "$1"
+  daemon_stop_timed
+}
+
 # can_flap CYCLES: with tacse3d streaming on vcan0, takes vcan0 down and up CYCLES times. After each
 # up the daemon's next Timestamp frame (0x021, node 1) must arrive within 5 s, read by a fresh
 # candump, and the daemon must still run. Writes "cycles= resumed= resume_ms_median= resume_ms_max="

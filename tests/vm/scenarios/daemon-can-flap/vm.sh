@@ -6,11 +6,4 @@
 set -eu
 . /tacse3/lib.sh
 
-vivid_two_sensors
-vcan_up vcan0
-need_daemon
-
-daemon_start ./board.toml
-timeout 30 candump -n 1 vcan0,028:7FF >/dev/null 2>&1 || fail "no Status frame within 30 s of the start"
-can_flap 20
-daemon_stop_timed
+can_flap_scenario 20
