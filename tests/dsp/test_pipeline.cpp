@@ -148,10 +148,11 @@ const Rendered& translation_along_y() {
 // Median and largest |fixed − reference| of the per-frame confidence.
 std::pair<double, double> confidence_difference(const std::vector<double>& a,
                                                 const std::vector<double>& b) {
-  std::vector<double> d;
-  for (std::size_t i = 0; i < a.size(); ++i) d.push_back(std::abs(a[i] - b[i]));
+  if (a.empty() || a.size() != b.size()) return {NAN, NAN};  // fails both EXPECT_LT below
+  std::vector<double> d(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) d[i] = std::abs(a[i] - b[i]);
   std::sort(d.begin(), d.end());
-  return {d[d.size() / 2], d.back()};
+  return {d[d.size() / 2], d[d.size() - 1]};
 }
 
 double rms_omega_difference(const std::vector<Vector6d>& a, const std::vector<Vector6d>& b) {
