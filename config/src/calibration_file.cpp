@@ -713,14 +713,16 @@ class TomlCharacterScan {
       state_ = State::kPlain;
       i_ += 2;
     } else if (c == '\\' && (state_ == State::kBasic || state_ == State::kMultiBasic)) {
-      if (state_ == State::kMultiBasic && line_ending_backslash()) return !ascii(t_[i_]);
-      // toml++ tests the character after a backslash for whitespace too; every TOML escape
-      // is ASCII, so a non-ASCII one is refused here.
-      if (i_ + 1 < t_.size() && !ascii(t_[i_ + 1])) {
+      // toml++ tests the character after a backslash, and after the blanks that follow one,
+      // for whitespace; every TOML escape is ASCII, so a non-ASCII one there is refused here.
+      std::size_t j = i_ + 1;
+      while (j < t_.size() && (t_[j] == ' ' || t_[j] == '\t' || t_[j] == '\r')) ++j;
+      if (j < t_.size() && !ascii(t_[j])) {
         escape_ = true;
-        ++i_;
+        i_ = j;
         return true;
       }
+      if (state_ == State::kMultiBasic && line_ending_backslash()) return !ascii(t_[i_]);
       ++i_;  // the escaped character
     }
     ++i_;
@@ -745,12 +747,27 @@ class TomlCharacterScan {
   bool escape_ = false;
 };
 
+// toml++'s error paths test the characters after a bad token for whitespace as well, wherever
+// they are; the copy of the text with every non-ASCII byte made 'x' has the same syntax errors at
+// the same places and reaches none of them. Returns its syntax error, or "" when it parses.
+std::string syntax_error_of_ascii_copy(std::string_view text, const std::string& origin) {
+  const auto non_ascii = [](char c) { return static_cast<unsigned char>(c) >= 0x80; };
+  if (std::none_of(text.begin(), text.end(), non_ascii)) return {};
+  std::string copy(text);
+  std::replace_if(copy.begin(), copy.end(), non_ascii, 'x');
+  const toml::parse_result parsed = toml::parse(copy, origin);
+  if (parsed) return {};
+  const auto& b = parsed.error().source().begin;
+  return origin + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) +
+         ": TOML syntax error: " + std::string(parsed.error().description());
+}
+
 }  // namespace
 
 std::string check_toml_characters(std::string_view text, const std::string& origin) {
   TomlCharacterScan scan(text);
   const std::size_t bad = scan.first_bad();
-  if (bad == std::string_view::npos) return {};
+  if (bad == std::string_view::npos) return syntax_error_of_ascii_copy(text, origin);
   const std::size_t line_start = text.rfind('\n', bad);
   const std::size_t line =
       1 + static_cast<std::size_t>(

@@ -233,6 +233,18 @@ TEST(Board, NonAsciiOutsideStringsIsRefusedBeforeToml) {
       << esc;
   const std::string esc1 = error_of("version = 1\nname = \"\\\xc3\xa9\"\n");
   EXPECT_NE(esc1.find("test.toml:2:10:"), std::string::npos) << esc1;
+  // ... and one after the blanks that follow a backslash, on the same line.
+  const std::string blank = error_of("name = \"\"\"\\ \xc5\x82'''';\nv = 1\n");
+  EXPECT_NE(
+      blank.find("test.toml:1:13: TOML syntax error: a non-ASCII character after a backslash"),
+      std::string::npos)
+      << blank;
+  // A syntax error before a non-ASCII character in what would be a string (fuzz_board).
+  const std::string after_error = error_of(
+      "lr  =-9_99\"99\xca\x89"
+      "ec9 \x01");
+  EXPECT_NE(after_error.find("test.toml:1:"), std::string::npos) << after_error;
+  EXPECT_NE(after_error.find("TOML syntax error"), std::string::npos) << after_error;
   // Strings and comments may hold any UTF-8, as TOML allows.
   BoardConfig b;
   std::string e;
