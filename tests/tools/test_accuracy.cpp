@@ -31,19 +31,6 @@ tacse3::config::CalibrationSet committed_calibration() {
   return cal;
 }
 
-// A simulated grasp with tacse3-sim's default timeline (radius 0 = the preset's size).
-tt::SimCase sim_case(const char* object, const char* motion, double magnitude, std::uint64_t seed,
-                     double radius, double indentation = 1.0) {
-  tt::SimCase c;
-  c.object = object;
-  c.motion = motion;
-  c.magnitude = magnitude;
-  c.seed = seed;
-  c.radius_mm = radius;
-  c.indentation_mm = indentation;
-  return c;
-}
-
 // Changes the case's simulator configuration before rendering (settings tacse3-sim has and
 // SimCase does not carry, such as the motion's duration).
 using SimAlteration = std::function<void(tacse3::sim::SimConfig&)>;
@@ -62,7 +49,7 @@ std::unique_ptr<tt::SimSource> open_sim(const tt::SimCase& c, std::string* err,
 // The same with a shorter timeline, for the calibrate-and-evaluate regression.
 tt::SimCase short_case(const char* object, const char* motion, double magnitude, std::uint64_t seed,
                        double radius) {
-  tt::SimCase c = sim_case(object, motion, magnitude, seed, radius);
+  tt::SimCase c = tt::make_sim_case(object, motion, magnitude, seed, radius);
   c.approach_s = 0.05;
   c.grasp_s = 0.25;
   c.settle_s = 0.05;
@@ -239,7 +226,7 @@ TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
   // A stick torsion of a small sphere (small contacts, short levers). The hold starts 1.17 s in
   // (frame 140 of 188): the right pad misses 140-149 and 165-174.
   const WholeAndAltered r = replay_whole_and_altered(
-      sim_case("sphere", "rz", 4.0, 1, 15.0), cal,
+      tt::make_sim_case("sphere", "rz", 4.0, 1, 15.0), cal,
       [](std::size_t i, std::array<const tacse3::dsp::FrameView*, 2>& views, std::int64_t&) {
         if ((i >= 140 && i < 150) || (i >= 165 && i < 175)) {
           views[1] = nullptr;
@@ -267,9 +254,10 @@ TEST(Accuracy, APadMissingForFramesOfTheHoldDoesNotTurnTheObject) {
 TEST(Accuracy, SticksOnSmallOrDeeplyPressedObjectsAreNotCalledSlips) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
-  const std::vector<tt::SimCase> cases = {
-      sim_case("sphere", "rz", 3, 3, 15), sim_case("sphere", "ry", 2, 3, 12),
-      sim_case("sphere", "rz", 3, 4, 0, 1.5), sim_case("screwdriver", "rx", 2, 2, 0)};
+  const std::vector<tt::SimCase> cases = {tt::make_sim_case("sphere", "rz", 3, 3, 15),
+                                          tt::make_sim_case("sphere", "ry", 2, 3, 12),
+                                          tt::make_sim_case("sphere", "rz", 3, 4, 0, 1.5),
+                                          tt::make_sim_case("screwdriver", "rx", 2, 2, 0)};
   const std::vector<tt::EvalConfig> cfg = {
       {tacse3::dsp::FusionMethod::kJoint, tt::ProxyMode::kAuto, tt::SensorChoice::kBoth, false}};
   for (const tt::SimCase& c : cases) {
@@ -312,7 +300,7 @@ TEST(Accuracy, TheGraspOfAnOffCentreContactIsNotPaidBackAsASlide) {
       for (auto& s : cal.sensor) s.max_mask_area_ratio = 1e4;
     }
     for (const char* axis : {"tx", "ty"}) {
-      const tt::SimCase c = sim_case("sphere", axis, 10.0, 3, 0.0);
+      const tt::SimCase c = tt::make_sim_case("sphere", axis, 10.0, 3, 0.0);
       std::string err;
       const auto src = open_sim(c, &err);
       ASSERT_TRUE(src) << err;
@@ -364,7 +352,7 @@ TEST(Accuracy, TheGraspOfAnOffCentreContactIsNotPaidBackAsASlide) {
 // shifted frame. A tight residual bound (0.15 of the template energy) leaves points around and
 // inside the patch untracked, and the smoothed field, 𝒢 and the mask lean away from them.
 TEST(Accuracy, TheFlowTracksThePressedGelEverywhere) {
-  const tt::SimCase c = sim_case("sphere", "rz", 30, 1, 0);
+  const tt::SimCase c = tt::make_sim_case("sphere", "rz", 30, 1, 0);
   std::string err;
   const auto src = open_sim(c, &err);
   ASSERT_TRUE(src) << err;
@@ -427,7 +415,7 @@ TEST(Accuracy, AFlatFaceFirstSeenAtACornerIsNotReadAsATranslation) {
   tacse3::config::CalibrationSet committed = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
   for (auto& s : committed.sensor) s.slip_min_shift_m = 10e-6;
-  const tt::SimCase c = sim_case("textured-cube", "tx", 10.0, 2, 0.0);
+  const tt::SimCase c = tt::make_sim_case("textured-cube", "tx", 10.0, 2, 0.0);
   tacse3::config::CalibrationSet off = committed;
   for (auto& s : off.sensor) s.max_mask_area_ratio = 1e4;
   const tt::PoseErrors on_e = replay_errors(c, committed);
@@ -448,8 +436,8 @@ TEST(Accuracy, AFlatFaceFirstSeenAtACornerIsNotReadAsATranslation) {
 TEST(Accuracy, AChainThatTookAWrongMatchIsReanchoredToTheTare) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
-  for (const tt::SimCase& c :
-       {sim_case("screwdriver", "tx", 10.0, 2, 0.0), sim_case("sphere", "tx", 10.0, 4, 0.0, 2.0)}) {
+  for (const tt::SimCase& c : {tt::make_sim_case("screwdriver", "tx", 10.0, 2, 0.0),
+                               tt::make_sim_case("sphere", "tx", 10.0, 4, 0.0, 2.0)}) {
     const tt::PoseErrors e = replay_errors(c, cal);
     std::printf("%s: translation %.2f mm for 10 mm, error %.2f mm (rotation drift %.2f deg)\n",
                 c.sim_arguments().c_str(), e.estimated_translation_mm, e.final_translation_error_mm,
@@ -471,9 +459,9 @@ TEST(Accuracy, AReleasedGraspKeepsThePoseItHeld) {
   ASSERT_FALSE(::testing::Test::HasFailure());
   tacse3::config::CalibrationSet no_gate = committed;
   for (auto& s : no_gate.sensor) s.release_load_rate = 1e4;
-  tt::SimCase rx = sim_case("sphere", "rx", 2.0, 3, 0.0);
+  tt::SimCase rx = tt::make_sim_case("sphere", "rx", 2.0, 3, 0.0);
   rx.release_s = 0.3;
-  tt::SimCase ty = sim_case("sphere", "ty", 0.5, 3, 0.0);
+  tt::SimCase ty = tt::make_sim_case("sphere", "ty", 0.5, 3, 0.0);
   ty.release_s = 0.3;
   const tt::PoseErrors rx_on = replay_errors(rx, committed);
   const tt::PoseErrors rx_off = replay_errors(rx, no_gate);
@@ -498,7 +486,7 @@ TEST(Accuracy, AReleasedGraspKeepsThePoseItHeld) {
 TEST(Accuracy, AFrameGapDuringAStickMotionKeepsThePatchAnchor) {
   const tacse3::config::CalibrationSet cal = committed_calibration();
   ASSERT_FALSE(::testing::Test::HasFailure());
-  const tt::SimCase c = sim_case("sphere", "rx", 4.0, 1, 0.0);
+  const tt::SimCase c = tt::make_sim_case("sphere", "rx", 4.0, 1, 0.0);
   // The motion runs 0.6-1.17 s; from 0.9 s (frame 108, a little past the middle) the clock
   // jumps by 0.2 s.
   const WholeAndAltered r = replay_whole_and_altered(
@@ -559,7 +547,7 @@ TEST(Accuracy, TheVelocityProxyReadsAnInPlaneSlideAtAnySpeed) {
   double read[2] = {0.0, 0.0};
   const double motion_s[2] = {0.5, 2.0};
   for (int k = 0; k < 2; ++k) {
-    tt::SimCase c = sim_case("sphere", "rx", 30, 1, 0);
+    tt::SimCase c = tt::make_sim_case("sphere", "rx", 30, 1, 0);
     c.friction = 5.0;
     const tt::PoseErrors e =
         replay_errors(c, cal, tt::ProxyMode::kVelocity,
@@ -582,7 +570,7 @@ TEST(Accuracy, WithoutTheFrictionCapThirtyAndNinetyDegreesReadWithOneGain) {
   double per_degree[2] = {0.0, 0.0};
   const double angle[2] = {30.0, 90.0};
   for (int k = 0; k < 2; ++k) {
-    tt::SimCase c = sim_case("sphere", "rx", angle[k], 1, 0);
+    tt::SimCase c = tt::make_sim_case("sphere", "rx", angle[k], 1, 0);
     c.friction = 5.0;
     const tt::PoseErrors e = replay_errors(c, cal);
     per_degree[k] = e.estimated_rotation_deg / angle[k];

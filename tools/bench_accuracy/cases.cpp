@@ -10,18 +10,6 @@ using tools::ProxyMode;
 using tools::SensorChoice;
 using tools::SimCase;
 
-SimCase mk(const char* object, const char* motion, double magnitude, std::uint64_t seed = 1,
-           double radius = 0.0, double indentation = 1.0) {
-  SimCase c;
-  c.object = object;
-  c.motion = motion;
-  c.magnitude = magnitude;
-  c.seed = seed;
-  c.radius_mm = radius;
-  c.indentation_mm = indentation;
-  return c;
-}
-
 void add_configs(Row& r, bool reference) {
   auto add = [&](FusionMethod m, ProxyMode mode, SensorChoice s, bool ref) {
     r.configs.push_back({m, mode, s, ref});
@@ -49,7 +37,7 @@ void add_rotation_rows(bool quick, std::vector<Row>* rows) {
   for (int a = 0; a < 3; ++a) {
     for (int k = 0; k < (quick ? 1 : 3); ++k) {
       Row r;
-      r.c = mk("sphere", axes[a], angles[k]);
+      r.c = tools::make_sim_case("sphere", axes[a], angles[k]);
       r.vb = true;
       r.paper_vb = vb[a][k];
       if (k == 0) {
@@ -70,7 +58,7 @@ void add_translation_rows(std::vector<Row>* rows) {
   const char* taxes[2] = {"tx", "ty"};
   for (int a = 0; a < 2; ++a) {
     Row r;
-    r.c = mk("sphere", taxes[a], 10);
+    r.c = tools::make_sim_case("sphere", taxes[a], 10);
     r.vc = true;
     r.paper_vc_single_drift = vc_tr[a][0];
     r.paper_vc_single_trans = vc_tr[a][1];
@@ -104,7 +92,7 @@ void add_object_rows(bool quick, std::vector<Row>* rows) {
   for (const auto& v : vd) {
     if (quick && !v.quick) continue;
     Row r;
-    r.c = mk(v.object, v.motion, 30);
+    r.c = tools::make_sim_case(v.object, v.motion, 30);
     r.vd = true;
     r.vd_object = v.name;
     r.paper_vd = v.paper;
@@ -128,7 +116,7 @@ void add_stick_rows(bool quick, std::vector<Row>* rows) {
   for (const auto& s : st) {
     if (quick && !s.quick) continue;
     Row r;
-    r.c = mk(s.object, s.motion, s.magnitude);
+    r.c = tools::make_sim_case(s.object, s.motion, s.magnitude);
     r.stick = true;
     rows->push_back(r);
   }
@@ -145,18 +133,28 @@ void finish_rows(const std::string& profile, bool reference, std::vector<Row>* r
 
 std::vector<SimCase> calibration_set(bool quick, const std::string& profile) {
   // Different seeds, radii and indentations from the test rows.
-  std::vector<SimCase> c = {mk("sphere", "rx", 30, 7, 18, 0.8), mk("sphere", "rz", 30, 7, 18, 0.8),
-                            mk("sphere", "tx", 10, 7, 18, 0.8), mk("sphere", "rz", 3, 7, 18, 0.8),
-                            mk("sphere", "ry", 2, 7, 18, 0.8),  mk("sphere", "tx", 0.3, 7, 18, 0.8),
-                            mk("sphere", "ty", 10, 7, 18, 0.8)};
+  std::vector<SimCase> c = {tools::make_sim_case("sphere", "rx", 30, 7, 18, 0.8),
+                            tools::make_sim_case("sphere", "rz", 30, 7, 18, 0.8),
+                            tools::make_sim_case("sphere", "tx", 10, 7, 18, 0.8),
+                            tools::make_sim_case("sphere", "rz", 3, 7, 18, 0.8),
+                            tools::make_sim_case("sphere", "ry", 2, 7, 18, 0.8),
+                            tools::make_sim_case("sphere", "tx", 0.3, 7, 18, 0.8),
+                            tools::make_sim_case("sphere", "ty", 10, 7, 18, 0.8)};
   if (!quick) {
-    for (const auto& x : {mk("sphere", "ry", 30, 8, 22, 1.2), mk("sphere", "rz", 60, 8, 22, 1.2),
-                          mk("sphere", "ty", 10, 8, 22, 1.2), mk("sphere", "rx", 3, 8, 22, 1.2),
-                          mk("sphere", "rx", 30, 8, 22, 1.2), mk("sphere", "tx", 10, 8, 22, 1.2),
-                          mk("sphere", "ry", 30, 7, 18, 0.8), mk("sphere", "rx", 3, 7, 18, 0.8),
-                          mk("sphere", "ty", 0.5, 7, 18, 0.8), mk("sphere", "ry", 2, 8, 22, 1.2),
-                          mk("sphere", "tx", 0.3, 8, 22, 1.2), mk("sphere", "ty", 0.5, 8, 22, 1.2),
-                          mk("ellipsoid", "rz", 30, 9), mk("cube", "rz", 2, 9)}) {
+    for (const auto& x : {tools::make_sim_case("sphere", "ry", 30, 8, 22, 1.2),
+                          tools::make_sim_case("sphere", "rz", 60, 8, 22, 1.2),
+                          tools::make_sim_case("sphere", "ty", 10, 8, 22, 1.2),
+                          tools::make_sim_case("sphere", "rx", 3, 8, 22, 1.2),
+                          tools::make_sim_case("sphere", "rx", 30, 8, 22, 1.2),
+                          tools::make_sim_case("sphere", "tx", 10, 8, 22, 1.2),
+                          tools::make_sim_case("sphere", "ry", 30, 7, 18, 0.8),
+                          tools::make_sim_case("sphere", "rx", 3, 7, 18, 0.8),
+                          tools::make_sim_case("sphere", "ty", 0.5, 7, 18, 0.8),
+                          tools::make_sim_case("sphere", "ry", 2, 8, 22, 1.2),
+                          tools::make_sim_case("sphere", "tx", 0.3, 8, 22, 1.2),
+                          tools::make_sim_case("sphere", "ty", 0.5, 8, 22, 1.2),
+                          tools::make_sim_case("ellipsoid", "rz", 30, 9),
+                          tools::make_sim_case("cube", "rz", 2, 9)}) {
       c.push_back(x);
     }
   }

@@ -35,6 +35,20 @@ struct SimCase {
   std::string sim_arguments() const;
 };
 
+// A grasp with tacse3-sim's default timeline: the fields the benchmark's tables vary.
+inline SimCase make_sim_case(const char* object, const char* motion, double magnitude,
+                             std::uint64_t seed = 1, double radius_mm = 0.0,
+                             double indentation_mm = 1.0) {
+  SimCase c;
+  c.object = object;
+  c.motion = motion;
+  c.magnitude = magnitude;
+  c.seed = seed;
+  c.radius_mm = radius_mm;
+  c.indentation_mm = indentation_mm;
+  return c;
+}
+
 // "all", a name, or a comma-separated list of names → the profiles, in the simulator's order
 // for "all". Error text names the unknown profile.
 std::string parse_profile_list(const std::string& text, std::vector<std::string>* out);
