@@ -249,6 +249,7 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     c.szz += z * z;
   };
   std::int64_t common = 0, common_dx = 0, common_dy = 0;
+  std::int64_t anchored_common = 0, anchored_dx = 0, anchored_dy = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
     if (contact.mask.v[i] == 0) continue;
     const std::int64_t x = clamp64(contact.x_nm.v[i], -kMaxPointNm, kMaxPointNm);
@@ -276,9 +277,16 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
         add_point(m_anchored, x, y, z);
         sum_anchored.add(x, y, z, dx, dy);
       }
+      const std::int64_t step_x = x - clamp64(prev_x_nm_.v[i], -kMaxPointNm, kMaxPointNm);
+      const std::int64_t step_y = y - clamp64(prev_y_nm_.v[i], -kMaxPointNm, kMaxPointNm);
       ++common;
-      common_dx += x - clamp64(prev_x_nm_.v[i], -kMaxPointNm, kMaxPointNm);
-      common_dy += y - clamp64(prev_y_nm_.v[i], -kMaxPointNm, kMaxPointNm);
+      common_dx += step_x;
+      common_dy += step_y;
+      if (anchored) {
+        ++anchored_common;
+        anchored_dx += step_x;
+        anchored_dy += step_y;
+      }
     }
   }
   out.points = static_cast<int>(m.n);
@@ -413,8 +421,14 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       // While the contact sticks the gel material moves with the object, so the mean displacement
       // of the material points in both masks is the contact displacement itself. The mask
       // centroid is not used here: a tangential load stretches the gel behind the patch and
-      // compresses it ahead, which moves Ω (read from 𝒢) backwards although nothing slid.
-      disp = common_disp;
+      // compresses it ahead, which moves Ω (read from 𝒢) backwards although nothing slid. For
+      // the same reason the mean is over the anchored patch when it has common points: Ω grows
+      // over stretched gel that lags the object, which would dilute the mean.
+      disp = anchored_common > 0
+                 ? Eigen::Vector2d(Eigen::Vector2d(static_cast<double>(anchored_dx),
+                                                   static_cast<double>(anchored_dy)) /
+                                   static_cast<double>(anchored_common) * kNm)
+                 : common_disp;
       out.translation_source = TranslationSource::kCommonPoints;
       out.translation_valid = true;
     } else if (slide_source != TranslationSource::kNone) {

@@ -531,6 +531,75 @@ TEST(Motion, AHeldTangentialLoadIsReadOverThePatchNotTheStretchedGel) {
   EXPECT_NEAR(g.omega.z(), num / den, 0.01);
 }
 
+// The same stretch under a stick translation: the material points of the patch move with the
+// object, those of the ring Ω grows over move half as far. The stick rule reads the mean
+// displacement of the anchored patch's common points, the object's own; over all of
+// Ω_t ∩ Ω_{t−1} the ring would dilute it. Fixed path and double reference alike.
+TEST(Motion, AStickTranslationIsReadOverThePatchNotTheStretchedGel) {
+  const Calibration cal = exact_displacement_cal();
+  RigidContactScene small, large;
+  small.radius_m = 3e-3;
+  large.radius_m = 4.5e-3;
+  SyntheticSensorFrames fs = dsp_ref::render_rigid_contact(cal, small);
+  SyntheticSensorFrames fl = dsp_ref::render_rigid_contact(cal, large);
+  VectorField zero;
+  zero.x.fill(0);
+  zero.y.fill(0);
+  fs.w_now = zero;
+  Runner run(cal);
+  (void)run.frame(fs.fz, fs.w_now, zero);  // the grasp, unloaded: anchors the patch
+  const GridMask patch = run.cs->mask;
+  // A tangential load along x: a uniform shear whose content is far above slip_min_shift_m, so
+  // the anchor is kept; the patch's material moves by k·step, the ring's by k·step/2.
+  constexpr std::int32_t kStepQ16 = 1 << 15;  // half a working-grid pixel per frame
+  VectorField shear = zero;
+  shear.x.fill(std::int32_t{1} << 20);
+  const auto loaded = [&](int k) {
+    SyntheticSensorFrames f = fl;
+    f.w_now = zero;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i)
+      f.w_now.x.v[i] = patch.v[i] != 0 ? k * kStepQ16 : k * kStepQ16 / 2;
+    return f;
+  };
+  const SyntheticSensorFrames f1 = loaded(1), f2 = loaded(2);
+  std::vector<GridMask> masks{patch};
+  const SensorMotion b = run.frame(f1.fz, f1.w_now, shear);
+  EXPECT_FALSE(b.anchor_set);
+  masks.push_back(run.cs->mask);
+  const ContactSet before = *run.cs;
+  const SensorMotion c = run.frame(f2.fz, f2.w_now, shear);
+  masks.push_back(run.cs->mask);
+  // The patch's displacement (nm) and the mean over every common point.
+  double patch_dx = 0.0, all_dx = 0.0;
+  int n_patch = 0, n_all = 0, ring = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
+    if (run.cs->mask.v[i] == 0 || before.mask.v[i] == 0) continue;
+    const double dx = run.cs->x_nm.v[i] - before.x_nm.v[i];
+    all_dx += dx;
+    ++n_all;
+    if (patch.v[i] != 0) {
+      patch_dx += dx;
+      ++n_patch;
+    } else {
+      ++ring;
+    }
+  }
+  ASSERT_GT(ring, 20);
+  ASSERT_GT(n_patch, 20);
+  patch_dx /= n_patch;
+  all_dx /= n_all;
+  ASSERT_TRUE(c.translation_valid);
+  EXPECT_EQ(c.translation_source, TranslationSource::kCommonPoints);
+  EXPECT_NEAR(c.translation.x() * kDt * 1e9, patch_dx, 1.0);
+  EXPECT_NEAR(c.translation.y(), 0.0, 1e-9);
+  EXPECT_LT(all_dx, 0.9 * patch_dx) << "the ring dilutes the mean: the test tells the rules apart";
+
+  const std::vector<dsp_ref::SensorMotionRef> r =
+      reference_run(cal, {&fs, &f1, &f2}, {&zero, &shear, &shear}, masks);
+  ASSERT_TRUE(r[2].translation_valid);
+  EXPECT_NEAR(r[2].translation.x(), c.translation.x(), 1e-4 * std::abs(c.translation.x()));
+}
+
 // The anchor's fallback: a contact that has left every anchored cell while loaded (here the
 // patch moves off it in one frame, a tangential load held) is read over Ω_t ∩ Ω_{t−1} rather
 // than from nothing. Fixed path and double reference alike.

@@ -117,7 +117,9 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
   // Height-weighted sums for the sliding rule's centroid (dsp::MotionEstimator's rule).
   Eigen::Vector3d zsum_now = Eigen::Vector3d::Zero(), zsum_prev = Eigen::Vector3d::Zero();
   double z_now = 0.0, z_prev = 0.0;
-  Eigen::Vector3d sum_common = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sum_common = Eigen::Vector3d::Zero(),
+                  sum_anchored_common = Eigen::Vector3d::Zero();
+  int anchored_common = 0;
   // Per point: shear (velocity reading, over Ω and over Ω ∩ anchor), increment (displacement
   // reading).
   std::vector<PointSample> shear_pts, held_pts, incr_pts, anchored_pts;
@@ -152,6 +154,10 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     if (prev_mask_[i] != 0) {
       ++common;
       sum_common += s.q - prev_q_[i];
+      if (anchored) {
+        ++anchored_common;
+        sum_anchored_common += s.q - prev_q_[i];
+      }
     }
   }
   out.points = static_cast<int>(shear_pts.size());
@@ -281,7 +287,8 @@ SensorMotionRef MotionRef::update(const ContactSetRef& c, const std::vector<doub
     }
     Eigen::Vector3d d = Eigen::Vector3d::Zero();
     if (sticking && common > 0) {
-      d = common_d;
+      // The anchored patch's common points if any (dsp::MotionEstimator's rule).
+      d = anchored_common > 0 ? Eigen::Vector3d(sum_anchored_common / anchored_common) : common_d;
       out.translation_source = 2;
       out.translation_valid = true;
     } else if (slide_source != 0) {
