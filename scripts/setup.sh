@@ -18,6 +18,8 @@ PACKAGES=(
   # libraries
   libeigen3-dev googletest libgtest-dev libbenchmark-dev
   libtomlplusplus-dev libcli11-dev libspng-dev libpng-dev nlohmann-json3-dev
+  # OpenCV's DIS optical flow, for the bench-only comparison tacse3_bench_vs_dis
+  libopencv-video-dev
   # hardware backends: MJPEG decode, GPIO, libcamera
   libturbojpeg0-dev libgpiod-dev libcamera-dev
   # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks,
