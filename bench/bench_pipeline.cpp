@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 bench: the whole dual-sensor frame pair through DualPipeline, steady state and per stage.
+// tacse3 bench: the whole dual-sensor frame pair through DualPipeline, steady state and per stage,
+// and the per-pair cost distribution over simulated grasps with their rare events.
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -7,6 +8,9 @@
 
 #include "support/scenes.hpp"
 #include "tacse3/dsp/pipeline.hpp"
+#ifdef TACSE3_BENCH_HAVE_SIM
+#include "pair_sequence.hpp"
+#endif
 
 namespace {
 
@@ -80,6 +84,22 @@ void BM_SensorPipeline(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_SensorPipeline)->Unit(benchmark::kMicrosecond);
+
+#ifdef TACSE3_BENCH_HAVE_SIM
+// Simulated grasps (pair_sequence.hpp) pair by pair: the distribution of the per-pair CPU time,
+// and which event the slowest pair carried. One iteration is the whole sequence.
+void BM_DualFramePairSequence(benchmark::State& state) {
+  const bench::PairSequence& seq = bench::pair_sequence();
+  if (!seq.error.empty()) {
+    state.SkipWithError(seq.error.c_str());
+    return;
+  }
+  bench::PairTimes times;
+  for (auto _ : state) times = bench::run_pair_sequence(seq);
+  bench::report_pair_times(times, state);
+}
+BENCHMARK(BM_DualFramePairSequence)->Iterations(1)->Unit(benchmark::kMillisecond);
+#endif
 
 }  // namespace
 

@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 bench: a long dual-pad sequence of simulated grasps with the pipeline's rare events
+// (keyframe switches, contact onset and release, tares, a lost pad), timed pair by pair.
+#pragma once
+
+#include <benchmark/benchmark.h>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace tacse3::bench {
+
+// What a frame pair carries, as bit flags; a pair may carry several.
+enum PairEvent : unsigned {
+  kKeyframeSwitch = 1u << 0,  // either pad's block flow took a new keyframe
+  kOnset = 1u << 1,           // either pad's true contact began
+  kRelease = 1u << 2,         // either pad's true contact ended
+  kTare = 1u << 3,            // the pipeline was tared just before the pair
+  kLostPad = 1u << 4,         // one pad's frame is missing, or is back after missing
+};
+inline constexpr int kPairEventCount = 5;
+const char* event_name(unsigned event) noexcept;
+std::string event_names(unsigned events);  // "keyframe switch+onset", or "none"
+
+struct PairFrames {
+  std::array<std::vector<std::uint8_t>, 2> pad;  // GREY 320x240; empty: no frame this cycle
+  unsigned events = 0;                           // all but kKeyframeSwitch, known in advance
+};
+
+struct PairSequence {
+  std::vector<PairFrames> pairs;
+  std::string error;  // rendering failed
+};
+
+// Rendered once, on first use: six grasps with release (tacse3-sim --release-s 0.2), each
+// preceded by a tare, one of them with a left pad lost for a few cycles mid-motion.
+const PairSequence& pair_sequence();
+
+struct PairTimes {
+  std::vector<double> us;  // thread CPU time of each pair (tare included on its pair)
+  std::vector<unsigned> events;
+};
+
+PairTimes run_pair_sequence(const PairSequence& seq);
+
+// Counters p50_us, p99_us, max_us and the largest pair of each event (<event>_max_us); the label
+// names the slowest pair and its events.
+void report_pair_times(const PairTimes& times, benchmark::State& state);
+
+}  // namespace tacse3::bench
