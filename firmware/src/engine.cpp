@@ -54,14 +54,6 @@ double us_to_s(std::int64_t us) noexcept {
   return us < 0 ? kNaN : static_cast<double>(us) * 1e-6;
 }
 
-// Contact area of one sensor: |Ω| flow-grid cells of (320 / kGridWidth) sensor pixels squared.
-double contact_area_m2(const dsp::SensorPipeline& p) noexcept {
-  const auto& cal = p.calibration();
-  const double cell_m =
-      cal.pixel_pitch_m * (static_cast<double>(dsp::kSensorWidth) / dsp::kGridWidth);
-  return static_cast<double>(p.fields().contact.count) * cell_m * cell_m * cal.pixel_aspect_y;
-}
-
 }  // namespace
 
 dsp::VelocityProxy to_dsp_proxy(protocol::VelocityMode m, dsp::VelocityProxy calibrated) noexcept {
@@ -318,8 +310,8 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   const std::int64_t t0 = hal::monotonic_ns();
   pipeline_.process(l, r, t_ns, result_);
   const std::int64_t t1 = hal::monotonic_ns();
-  dsp_time_.add(
-      static_cast<std::uint32_t>(std::clamp<std::int64_t>((t1 - t0) / 1000, 0, UINT32_MAX)));
+  last_dsp_us_ = std::clamp<std::int64_t>((t1 - t0) / 1000, 0, UINT32_MAX);
+  dsp_time_.add(static_cast<std::uint32_t>(last_dsp_us_));
 #if TACSE3_HAVE_RECORDER
   if (recorder_ != nullptr) recorder_->record(t_ns, l, r);
 #endif
@@ -368,6 +360,7 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   const std::int64_t latency_ns = t_sent - t_first_ns;
   if (latency_ns > 0 && latency_ns < 10'000'000'000) {
     latency_.add(static_cast<std::uint32_t>(latency_ns / 1000));
+    last_latency_us_ = latency_ns / 1000;
   }
   pose_reset_pending_ = false;
   cycle_counter_ = static_cast<std::uint8_t>((cycle_counter_ + 1) & 0x0F);
@@ -554,7 +547,33 @@ bool Engine::step(std::int64_t now_ns) noexcept {
     worked = true;
   }
   channel_.service();
+  if (view_ != nullptr && now_ns >= next_view_ns_) publish_view(now_ns);
   return worked;
+}
+
+// The live viewer's copy: at most every kViewPeriodNs, a bounded copy into the slot's back
+// buffer (no allocation, no lock); the viewer thread encodes and serves it.
+void Engine::publish_view(std::int64_t now_ns) noexcept {
+  ViewSnapshot& v = view_->back();
+  v.cycle = stats_.samples;
+  v.t_us = have_result_ ? last_t_ns_ / 1000 : 0;
+  v.state = static_cast<std::uint8_t>(state_.state);
+  v.have_result = have_result_;
+  v.valid = have_result_ && result_.valid;
+  v.single_sensor = result_.single_sensor;
+  v.calibrated = shared_.calibrated.load(std::memory_order_relaxed);
+  for (int i = 0; i < 3; ++i) {
+    v.w[static_cast<std::size_t>(i)] = result_.twist[i];
+    v.v[static_cast<std::size_t>(i)] = result_.twist[i + 3];
+  }
+  v.q = {result_.pose.q.w(), result_.pose.q.x(), result_.pose.q.y(), result_.pose.q.z()};
+  v.p = {result_.pose.p.x(), result_.pose.p.y(), result_.pose.p.z()};
+  v.confidence = have_result_ && result_.valid ? clamp01_or_nan(result_.confidence) : 0.0;
+  v.dsp_us = have_result_ ? last_dsp_us_ : -1;
+  v.latency_us = last_latency_us_;
+  fill_view_pads(pipeline_, result_, state_, config_.configured, &v);
+  view_->publish();
+  next_view_ns_ = now_ns + kViewPeriodNs;
 }
 
 }  // namespace tacse3::firmware

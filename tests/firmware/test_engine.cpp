@@ -159,6 +159,7 @@ class EngineTest : public ::testing::Test {
   SharedState shared_;
   std::unique_ptr<dsp::DualPipeline> pipeline_;
   std::unique_ptr<Engine> engine_;
+  std::unique_ptr<ViewSlot> view_ = std::make_unique<ViewSlot>();
   std::int64_t now_ = 0;
 };
 
@@ -410,6 +411,7 @@ TEST_F(EngineTest, LoopDoesNotAllocate) {
   }
   shared_.calibration = {pipeline_->sensor(dsp::SensorSlot::kLeft).calibration(),
                          pipeline_->sensor(dsp::SensorSlot::kRight).calibration()};
+  engine_->set_view(view_.get());  // the live viewer's publication is on
   test::reset_allocation_count();
   for (std::size_t i = 30; i < 150; ++i) {
     if (i % 20 == 0) commands_[0].push(pending[(i / 20) % pending.size()]);
@@ -422,4 +424,50 @@ TEST_F(EngineTest, LoopDoesNotAllocate) {
   EXPECT_EQ(shared_.calibration_flag.load(), SharedState::kApplied);
   EXPECT_EQ(engine_->stats().commands, 6u);
   EXPECT_EQ(engine_->state().state, protocol::State::kDegradedSingleSensor);
+  // At most one publication per 50 ms: on the 120 Hz ticks, the 7th after the last (6 periods
+  // are 49.99998 ms), so 120 ticks publish 17 or 18 times.
+  EXPECT_GE(view_->published(), 17u);
+  EXPECT_LE(view_->published(), 18u);
+}
+
+// What the viewer reads is the cycle as processed: the counters, the pose as a unit quaternion
+// equal to the pipeline's, the pads' images and contact.
+TEST_F(EngineTest, ViewSnapshotCarriesTheLastCycle) {
+  engine_->set_view(view_.get());
+  for (std::size_t i = 0; i < 40; ++i) tick(i);
+  ASSERT_TRUE(view_->take());
+  const ViewSnapshot& v = view_->front();
+  EXPECT_GT(v.cycle, 30u);
+  EXPECT_LE(v.cycle, engine_->stats().samples);
+  EXPECT_TRUE(v.have_result);
+  EXPECT_EQ(v.state, static_cast<std::uint8_t>(engine_->state().state));
+  const double n = v.q[0] * v.q[0] + v.q[1] * v.q[1] + v.q[2] * v.q[2] + v.q[3] * v.q[3];
+  EXPECT_NEAR(n, 1.0, 1e-9);
+  EXPECT_GE(v.dsp_us, 0);
+  for (const ViewPad& pad : v.pads) {
+    EXPECT_TRUE(pad.configured);
+    EXPECT_TRUE(pad.present);
+    int lo = 255, hi = 0;
+    for (std::uint8_t px : pad.luma) {
+      lo = std::min<int>(lo, px);
+      hi = std::max<int>(hi, px);
+    }
+    EXPECT_GT(hi - lo, 20) << "a flat image";
+    int cells = 0;
+    for (std::uint8_t m : pad.mask) cells += m;
+    EXPECT_EQ(pad.contact, cells > 0);
+    EXPECT_EQ(pad.contact_area_m2 > 0.0, cells > 0);
+  }
+  // Each tick processes one cycle; the tick that publishes publishes that cycle's pose.
+  bool published = false;
+  for (std::size_t i = 40; i < 50 && !published; ++i) {
+    tick(i);
+    published = view_->take();
+  }
+  ASSERT_TRUE(published) << "no publication within 10 periods (83 ms)";
+  const auto& r = engine_->last_result();
+  EXPECT_EQ(view_->front().cycle, engine_->stats().samples);
+  EXPECT_DOUBLE_EQ(view_->front().q[0], r.pose.q.w());
+  EXPECT_DOUBLE_EQ(view_->front().w[2], r.twist[2]);
+  EXPECT_DOUBLE_EQ(view_->front().p[2], r.pose.p.z());
 }

@@ -13,6 +13,7 @@
 #include "tacse3/firmware/latency.hpp"
 #include "tacse3/firmware/pairing.hpp"
 #include "tacse3/firmware/recording_mailbox.hpp"
+#include "tacse3/firmware/view_snapshot.hpp"
 #include "tacse3/hal/camera.hpp"
 #include "tacse3/hal/camera/spsc_ring.hpp"
 #include "tacse3/hal/can/channel.hpp"
@@ -101,6 +102,9 @@ class Engine {
   // before the DSP thread starts; START/STOP_RECORDING change it later (through
   // SharedState::recording).
   void set_recorder(FrameRecorder* recorder) noexcept { recorder_ = recorder; }
+  // --http: the slot the live viewer reads (null: no viewer, nothing is published). Set before
+  // the DSP thread starts.
+  void set_view(ViewSlot* slot) noexcept { view_ = slot; }
   // One loop iteration at now_ns (CLOCK_MONOTONIC). Returns true when it did work (the caller
   // sleeps briefly when it did not).
   bool step(std::int64_t now_ns) noexcept;
@@ -135,6 +139,7 @@ class Engine {
   protocol::StatusMsg status_message() const noexcept;
   void send_status_group() noexcept;
   void send_status_change() noexcept;
+  void publish_view(std::int64_t now_ns) noexcept;
   bool send(const protocol::CanFrame& f) noexcept;
 
   EngineConfig config_;
@@ -176,6 +181,10 @@ class Engine {
   std::array<bool, 2> slip_{};
   EngineStats stats_{};
   FrameRecorder* recorder_ = nullptr;
+  ViewSlot* view_ = nullptr;
+  std::int64_t next_view_ns_ = INT64_MIN;
+  std::int64_t last_dsp_us_ = -1;
+  std::int64_t last_latency_us_ = -1;
   protocol::Ack recording_ack_{};  // the START_RECORDING answer waiting for housekeeping
 };
 

@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: what the DSP thread shows the live viewer: one fixed-size copy of a cycle's
+// scalars, the per-pad grid fields and the working luma image (docs/viewer.md).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "tacse3/dsp/geometry.hpp"
+#include "tacse3/dsp/pipeline.hpp"
+#include "tacse3/firmware/health.hpp"
+#include "tacse3/firmware/snapshot_slot.hpp"
+
+namespace tacse3::firmware {
+
+// The DSP thread publishes at most once per this period (docs/viewer.md: 20 Hz).
+inline constexpr std::int64_t kViewPeriodNs = 50'000'000;
+
+struct ViewPad {
+  bool configured = false;
+  bool present = false;           // this pad took part in the last processed cycle
+  bool contact = false;           // Ω is not empty
+  bool slipping = false;          // the stick/slip detector's decision (kAuto proxy)
+  std::uint8_t health = 0;        // protocol::SensorHealth
+  double contact_area_m2 = 0.0;   // |Ω| times the area of one grid cell
+  double tracked_fraction = 0.0;  // valid block-flow points / grid points
+  std::array<std::uint8_t, dsp::kWorkPixels> luma{};  // working image, 8-bit (160 x 120)
+  std::array<std::uint8_t, dsp::kGridCount> mask{};   // Ω, 0/1, row-major 40 x 30
+  std::array<float, dsp::kGridCount> shear_x{};       // calibrated shear, shear units
+  std::array<float, dsp::kGridCount> shear_y{};
+  std::array<float, dsp::kGridCount> fz{};  // normal response f^z, f^z units
+};
+
+struct ViewSnapshot {
+  std::uint64_t cycle = 0;   // processed samples so far
+  std::int64_t t_us = 0;     // sample time of the last cycle (CLOCK_MONOTONIC)
+  std::uint8_t state = 0;    // protocol::State
+  bool have_result = false;  // at least one cycle was processed
+  bool valid = false;        // the last cycle's estimate is valid
+  bool single_sensor = false;
+  bool calibrated = false;
+  std::array<double, 3> w{};                    // rad/s in G
+  std::array<double, 3> v{};                    // m/s in G
+  std::array<double, 4> q{1.0, 0.0, 0.0, 0.0};  // w, x, y, z
+  std::array<double, 3> p{};                    // m
+  double confidence = 0.0;
+  std::int64_t dsp_us = -1;      // pipeline time of the last cycle
+  std::int64_t latency_us = -1;  // frame timestamp -> cycle sent, last cycle (-1: none)
+  std::array<ViewPad, 2> pads{};
+};
+
+using ViewSlot = SnapshotSlot<ViewSnapshot>;
+
+// Contact area of one sensor: |Ω| flow-grid cells of (320 / kGridWidth) sensor pixels squared.
+double contact_area_m2(const dsp::SensorPipeline& p) noexcept;
+
+// Fills every field of *out from the pipeline's last result (bounded copy, no allocation).
+void fill_view_pads(const dsp::DualPipeline& pipeline, const dsp::DualResult& result,
+                    const StateOutput& state, std::array<bool, 2> configured,
+                    ViewSnapshot* out) noexcept;
+
+}  // namespace tacse3::firmware
