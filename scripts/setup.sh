@@ -22,6 +22,8 @@ PACKAGES=(
   libopencv-video-dev
   # hardware backends: MJPEG decode, GPIO, libcamera
   libturbojpeg0-dev libgpiod-dev libcamera-dev
+  # tacse3d --http, the live viewer: the HTTP server (docs/viewer.md says why this one)
+  libcpp-httplib-dev
   # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks,
   # help2man for the manual pages made from each program's --help
   libsystemd-dev dpkg-dev file help2man

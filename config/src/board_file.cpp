@@ -2,6 +2,8 @@
 // tacse3 config: board file reader (toml++, no exceptions) with every key validated and named.
 #include "tacse3/config/board_file.hpp"
 
+#include "tacse3/config/listen_address.hpp"
+
 // Header-only toml++ without exceptions, as in calibration_file.cpp: a bad board file must come
 // back as a message, never as an exception or an assert. No header of config/ exposes toml++.
 #define TOML_HEADER_ONLY 1
@@ -380,7 +382,7 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
   }
   rd.only_keys(root, "",
                {"version", "name", "description", "sensors", "sim", "pipeline", "can", "gpio",
-                "realtime", "record", "rig"});
+                "realtime", "record", "rig", "viewer"});
   rd.string(root, "name", "", &b.name);
   rd.string(root, "description", "", &b.description);
 
@@ -507,6 +509,16 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
     rd.only_keys(*t, "rig", {"tcp_to_grasp"});
     b.rig.has_tcp_to_grasp = t->get("tcp_to_grasp") != nullptr;
     rd.pose(*t, "tcp_to_grasp", "rig", &b.rig.tcp_to_grasp);
+  }
+
+  if (const toml::table* t = rd.table(root, "viewer", "")) {
+    rd.only_keys(*t, "viewer", {"listen"});
+    rd.string(*t, "listen", "viewer", &b.viewer.listen);
+    ListenAddress a;
+    std::string e;
+    if (rd.ok() && !parse_listen_address(b.viewer.listen, &a, &e)) {
+      rd.fail(t->get("listen"), "key \"viewer.listen\": " + e);
+    }
   }
 
   if (!rd.ok()) {
@@ -645,6 +657,10 @@ std::string describe(const BoardConfig& b) {
   s << "\n  realtime: dsp cpu " << b.realtime.dsp_cpu << ", SCHED_FIFO priority "
     << b.realtime.dsp_priority << "\n";
   s << "  record: " << (b.record.dir.empty() ? "none (START_RECORDING refused)" : b.record.dir)
+    << "\n";
+  s << "  viewer: "
+    << (b.viewer.listen.empty() ? std::string("off")
+                                : std::string("http on ").append(b.viewer.listen))
     << "\n";
   return s.str();
 }

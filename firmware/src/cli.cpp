@@ -7,12 +7,14 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "tacse3/config/listen_address.hpp"
+
 namespace tacse3::firmware {
 
 const char* usage_text() noexcept {
   return "Usage: tacse3d --board NAME|PATH [--calibration FILE] [--can-log FILE|-]\n"
          "               [--can-socket PATH] [--can-iface IFACE] [--seconds S] [--record DIR]\n"
-         "               [--check] [--quiet|--verbose] [--help] [--version]\n"
+         "               [--http [ADDR:]PORT] [--check] [--quiet|--verbose] [--help] [--version]\n"
          "The tacse3 gripper firmware daemon: reads both tactile sensors, estimates the grasped\n"
          "object's motion and streams twist and pose over CAN.\n"
          "  --board NAME|PATH    board name (boards/NAME/board.toml) or a board.toml path\n"
@@ -27,6 +29,9 @@ const char* usage_text() noexcept {
          "  --can-iface IFACE    override the board's SocketCAN interface\n"
          "  --seconds S          stop after S seconds of streaming (0 = until SIGTERM/SIGINT)\n"
          "  --record DIR         record both raw sensor streams to DIR\n"
+         "  --http [ADDR:]PORT   serve the live web view (docs/viewer.md) on ADDR:PORT; a port\n"
+         "                       alone listens on 127.0.0.1 (default: the board's [viewer],\n"
+         "                       else off)\n"
          "  --check              validate board and calibration, print a summary, exit 0/1\n"
          "  --quiet | --verbose  fewer / more diagnostics on stderr\n"
          "  --help               print this help and exit\n"
@@ -106,6 +111,14 @@ bool parse_cli(int argc, const char* const* argv, Options* out, std::string* err
       if (!take(&o.record_dir)) return false;
       if (o.record_dir.empty()) {
         *error = "--record needs a directory; leave the option out to record nothing";
+        return false;
+      }
+    } else if (name == "--http") {
+      if (!take(&o.http)) return false;
+      config::ListenAddress addr;
+      std::string e;
+      if (!config::parse_listen_address(o.http, &addr, &e)) {
+        *error = std::string("--http ").append(e);
         return false;
       }
     } else if (name == "--check" && !has_inline) {

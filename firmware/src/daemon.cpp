@@ -11,6 +11,13 @@
 
 #include "tacse3/dsp/se3.hpp"
 #include "tacse3/firmware/system.hpp"
+#if TACSE3_HAVE_VIEWER
+#include "tacse3/firmware/view_server.hpp"
+#else
+namespace tacse3::firmware {
+class ViewServer {};  // --http is not built in; the member stays null
+}  // namespace tacse3::firmware
+#endif
 #if TACSE3_HAVE_RECORDER
 #include "tacse3/firmware/recorder.hpp"
 #else
@@ -345,7 +352,48 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
     return nullptr;
 #endif
   }
+  if (!d->start_viewer(error)) return nullptr;
   return d;
+}
+
+// --http, else the board's [viewer] listen: both checked by parse_listen_address already (the
+// command line and the board file reader); empty: no viewer, and the DSP thread publishes nothing.
+bool Daemon::start_viewer(std::string* error) {
+  const bool from_cli = !options_.http.empty();
+  const std::string text = from_cli ? options_.http : board_.viewer.listen;
+  if (text.empty()) return true;
+  const std::string what = from_cli ? std::string("--http ").append(text)
+                                    : board_.origin + ": [viewer] listen \"" + text + "\"";
+#if TACSE3_HAVE_VIEWER
+  ViewServerConfig vc;
+  std::string e;
+  if (!config::parse_listen_address(text, &vc.listen, &e)) {
+    *error = what + ": " + e;
+    return false;
+  }
+  vc.assets = find_viewer_assets(config::executable_dir());
+  if (vc.assets.empty()) {
+    *error = what + ": the viewer's page is not installed (" +
+             (config::executable_dir() / ".." / "share" / "tacse3" / "viewer").string() +
+             "/index.html is missing; reinstall the package or build tacse3_viewer_assets)";
+    return false;
+  }
+  view_slot_ = std::make_unique<ViewSlot>();
+  view_server_ = ViewServer::start(vc, *view_slot_, &e);
+  if (!view_server_) {
+    *error = what + ": " + e;
+    return false;
+  }
+  engine_->set_view(view_slot_.get());
+  say(1, "viewer: http://%s:%d/ (page from %s)", vc.listen.host.c_str(), vc.listen.port,
+      vc.assets.c_str());
+  return true;
+#else
+  *error = what +
+           ": this tacse3d was built without the live viewer (libcpp-httplib-dev or "
+           "libturbojpeg0-dev missing for this target)";
+  return false;
+#endif
 }
 
 Daemon::~Daemon() {
@@ -721,6 +769,16 @@ int Daemon::run(bool handle_signals) {
     if (t.joinable()) t.join();
   }
   rx.join();
+#if TACSE3_HAVE_VIEWER
+  if (view_server_) {
+    const ViewServer::Stats vs = view_server_->stats();
+    view_server_.reset();
+    say(1, "viewer: %llu snapshots served, %llu streams refused (too many), %llu dropped (slow)",
+        static_cast<unsigned long long>(vs.snapshots),
+        static_cast<unsigned long long>(vs.streams_refused),
+        static_cast<unsigned long long>(vs.streams_dropped));
+  }
+#endif
   engine_->release_all();
   for (std::size_t s = 0; s < 2; ++s) {
     const std::uint64_t bad = cameras_[s] ? cameras_[s]->stats().corrupt : 0;

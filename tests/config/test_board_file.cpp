@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tacse3/config/board_file.hpp"
+#include "tacse3/config/listen_address.hpp"
 
 namespace fs = std::filesystem;
 using namespace tacse3;
@@ -344,4 +345,47 @@ TEST(Board, BadRigTcpToGraspIsNamed) {
   const std::string key = error_of(std::string(kMinimal) + "[rig]\ntcp = 1\n");
   EXPECT_NE(key.find("unknown key \"rig.tcp\" (allowed here: tcp_to_grasp)"), std::string::npos)
       << key;
+}
+
+TEST(Board, ViewerListenIsOffByDefaultAndChecked) {
+  BoardConfig b;
+  std::string e;
+  ASSERT_TRUE(parse_board(kMinimal, "test.toml", &b, &e)) << e;
+  EXPECT_EQ(b.viewer.listen, "") << "no [viewer]: no web view";
+  ASSERT_TRUE(
+      parse_board(std::string(kMinimal) + "[viewer]\nlisten = \"8080\"\n", "test.toml", &b, &e))
+      << e;
+  EXPECT_EQ(b.viewer.listen, "8080");
+  const std::string port = error_of(std::string(kMinimal) + "[viewer]\nlisten = \"1.2.3.4:0\"\n");
+  EXPECT_NE(port.find("test.toml:5: key \"viewer.listen\": \"1.2.3.4:0\": the port must be"),
+            std::string::npos)
+      << port;
+  const std::string addr = error_of(std::string(kMinimal) + "[viewer]\nlisten = \"board:80\"\n");
+  EXPECT_NE(addr.find("the address must be an IPv4 address"), std::string::npos) << addr;
+}
+
+TEST(ListenAddress, PortAloneBindsToLocalhost) {
+  struct Case {
+    const char* text;
+    bool ok;
+    const char* host;
+    int port;
+  };
+  for (const Case& c :
+       {Case{"8080", true, "127.0.0.1", 8080}, Case{"0.0.0.0:80", true, "0.0.0.0", 80},
+        Case{"localhost:65535", true, "127.0.0.1", 65535},
+        Case{"192.168.1.20:8080", true, "192.168.1.20", 8080}, Case{"", false, "", 0},
+        Case{"0", false, "", 0}, Case{"65536", false, "", 0}, Case{"80x", false, "", 0},
+        Case{":80", false, "", 0}, Case{"1.2.3:80", false, "", 0}, Case{"1.2.3.4:", false, "", 0},
+        Case{"-1", false, "", 0}, Case{"[::1]:80", false, "", 0}}) {
+    ListenAddress a;
+    std::string e;
+    EXPECT_EQ(parse_listen_address(c.text, &a, &e), c.ok) << c.text;
+    if (c.ok) {
+      EXPECT_EQ(a.host, c.host) << c.text;
+      EXPECT_EQ(a.port, c.port) << c.text;
+    } else {
+      EXPECT_FALSE(e.empty()) << c.text;
+    }
+  }
 }

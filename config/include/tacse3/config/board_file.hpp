@@ -116,6 +116,11 @@ struct RecordBoardConfig {
   std::string dir;  // absolute path of an existing directory
 };
 
+// [viewer]: the live web view (docs/viewer.md). Empty listen: off.
+struct ViewerBoardConfig {
+  std::string listen;  // "PORT" or "ADDR:PORT", checked by parse_listen_address
+};
+
 struct BoardConfig {
   int version = kBoardVersion;
   std::string name;
@@ -128,6 +133,7 @@ struct BoardConfig {
   RealtimeConfig realtime;
   RecordBoardConfig record;
   RigBoardConfig rig;
+  ViewerBoardConfig viewer;
   std::string origin;  // the file it came from
 
   bool uses_backend(CameraBackend b) const noexcept {

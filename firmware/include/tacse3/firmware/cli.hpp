@@ -14,6 +14,7 @@ struct Options {
   std::string can_socket;   // non-empty: candump -L both ways on a Unix socket at this path
   double seconds = 0.0;     // 0 = until SIGTERM/SIGINT
   std::string record_dir;
+  std::string http;  // non-empty: serve the live viewer here (checked "PORT" or "ADDR:PORT")
   bool check = false;
   int verbosity = 1;  // 0 quiet, 1 normal, 2 verbose
   bool help = false;

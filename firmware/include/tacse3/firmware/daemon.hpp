@@ -30,6 +30,7 @@ namespace tacse3::firmware {
 
 class FrameRecorder;
 struct RecorderConfig;
+class ViewServer;
 
 // Where the calibration came from: built-in defaults or a file (reloaded on SIGHUP).
 struct CalibrationSource {
@@ -109,6 +110,7 @@ class Daemon {
   RecorderConfig recorder_config(double finger_separation_m) const;
   void service_recording();
   void close_recording();
+  bool start_viewer(std::string* error);
   void say(int level, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
 
   config::BoardConfig board_;
@@ -139,6 +141,10 @@ class Daemon {
   std::string recording_path_;
   bool recording_failure_reported_ = false;
   SharedState shared_;
+  // --http / [viewer] listen: the slot the DSP thread publishes into and the server reading it
+  // (declared in this order: the server goes first).
+  std::unique_ptr<ViewSlot> view_slot_;
+  std::unique_ptr<ViewServer> view_server_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> dsp_ready_{false};
   std::int64_t streaming_since_ns_ = 0;

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: the live viewer's HTTP server (cpp-httplib): the page, /api/state,
+// /api/stream (Server-Sent Events), /api/fields and the pads' JPEG images (docs/viewer.md).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "tacse3/config/listen_address.hpp"
+#include "tacse3/firmware/view_snapshot.hpp"
+
+namespace tacse3::firmware {
+
+struct ViewServerConfig {
+  config::ListenAddress listen;
+  std::filesystem::path assets;  // folder holding index.html, viewer.js, viewer.css, uPlot
+  int threads = 8;               // connections served at once
+  int max_streams = 4;           // /api/stream clients at once; more get 503
+  int write_timeout_ms = 2000;   // a client that takes no data this long is dropped
+  int nice = 10;                 // the server threads' niceness (the DSP thread is SCHED_FIFO)
+};
+
+// The viewer assets folder: <exe_dir>/../share/tacse3/viewer (the package's and the build
+// tree's). Empty when it holds no index.html.
+std::filesystem::path find_viewer_assets(const std::filesystem::path& exe_dir);
+
+class ViewServer {
+ public:
+  // Loads the assets, binds and starts serving, reading snapshots from `slot` (this server is its
+  // only reader). null with *error ("ADDR:PORT: address already in use", a missing asset).
+  static std::unique_ptr<ViewServer> start(const ViewServerConfig& config, ViewSlot& slot,
+                                           std::string* error);
+  ~ViewServer();  // stops serving and joins every thread
+  ViewServer(const ViewServer&) = delete;
+  ViewServer& operator=(const ViewServer&) = delete;
+
+  struct Stats {
+    std::uint64_t snapshots = 0;        // snapshots taken from the slot and rendered
+    std::uint64_t streams_refused = 0;  // /api/stream answered 503 (max_streams reached)
+    std::uint64_t streams_dropped = 0;  // streams ended because the client did not take data
+  };
+  Stats stats() const noexcept;
+
+  struct Impl;
+
+ private:
+  explicit ViewServer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tacse3::firmware

@@ -1,0 +1,312 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: the live viewer's HTTP server. Two kinds of threads, all at a lower priority
+// than the DSP thread: one sampler takes each snapshot from the slot and renders it once (JSON,
+// JPEG); the server's pool threads only hand out what was rendered, under a short lock.
+#include "tacse3/firmware/view_server.hpp"
+
+#include <httplib.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <turbojpeg.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <condition_variable>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "tacse3/firmware/view_json.hpp"
+
+namespace tacse3::firmware {
+
+namespace {
+
+constexpr int kJpegQuality = 85;
+constexpr auto kSamplePoll = std::chrono::milliseconds(10);
+constexpr auto kStreamHeartbeat = std::chrono::seconds(1);
+
+// A rendered snapshot, shared by every request that serves it.
+struct Rendered {
+  std::uint64_t seq = 0;
+  std::shared_ptr<const ViewSnapshot> snapshot;
+  std::string state_json;
+  std::array<std::string, 2> jpeg;  // empty: the pad is not configured
+};
+
+struct Asset {
+  std::string body;
+  const char* mime;
+};
+
+// The files the page is made of: served from memory, read once at start; nothing else on disk is
+// reachable. Optional files (the plotting library) may be absent: the page says so.
+struct AssetName {
+  const char* name;
+  const char* mime;
+  bool required;
+};
+constexpr AssetName kAssets[] = {
+    {"index.html", "text/html; charset=utf-8", true},
+    {"viewer.js", "text/javascript; charset=utf-8", true},
+    {"viewer.css", "text/css; charset=utf-8", true},
+    {"uPlot.iife.min.js", "text/javascript; charset=utf-8", false},
+    {"uPlot.min.css", "text/css; charset=utf-8", false},
+};
+
+bool read_file(const std::filesystem::path& p, std::string* out) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return false;
+  std::ostringstream s;
+  s << in.rdbuf();
+  *out = s.str();
+  return static_cast<bool>(in) || in.eof();
+}
+
+std::string encode_jpeg(tjhandle tj, const std::array<std::uint8_t, dsp::kWorkPixels>& luma) {
+  unsigned char* buf = nullptr;
+  unsigned long size = 0;
+  std::string out;
+  if (tjCompress2(tj, luma.data(), dsp::kWorkWidth, 0, dsp::kWorkHeight, TJPF_GRAY, &buf, &size,
+                  TJSAMP_GRAY, kJpegQuality, TJFLAG_FASTDCT) == 0) {
+    out.assign(reinterpret_cast<const char*>(buf), size);
+  }
+  tjFree(buf);
+  return out;
+}
+
+// Linux: nice is per thread, and threads inherit it from the thread that creates them.
+void lower_priority(int nice) {
+  setpriority(PRIO_PROCESS, 0, nice);
+}
+
+}  // namespace
+
+struct ViewServer::Impl {
+  Impl(const ViewServerConfig& c, ViewSlot& s) : config(c), slot(s) {}
+
+  ViewServerConfig config;
+  ViewSlot& slot;
+  httplib::Server server;
+  std::map<std::string, Asset> assets;
+  mutable std::mutex mutex;
+  std::condition_variable changed;
+  std::shared_ptr<const Rendered> latest;  // guarded by mutex
+  bool stopping = false;                   // guarded by mutex
+  std::atomic<int> streams{0};
+  std::atomic<std::uint64_t> snapshots{0};
+  std::atomic<std::uint64_t> refused{0};
+  std::atomic<std::uint64_t> dropped{0};
+  std::thread sampler;
+  std::thread listener;
+
+  std::shared_ptr<const Rendered> current() const {
+    std::lock_guard<std::mutex> lock(mutex);
+    return latest;
+  }
+
+  void sample_loop() {
+    lower_priority(config.nice);
+    tjhandle tj = tjInitCompress();
+    std::uint64_t seq = 0;
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!stopping) {
+      lock.unlock();
+      if (slot.take()) {
+        auto r = std::make_shared<Rendered>();
+        auto snap = std::make_shared<ViewSnapshot>(slot.front());
+        r->seq = ++seq;
+        r->state_json = view_state_json(*snap);
+        for (std::size_t s = 0; s < 2; ++s) {
+          if (snap->pads[s].configured && tj != nullptr)
+            r->jpeg[s] = encode_jpeg(tj, snap->pads[s].luma);
+        }
+        r->snapshot = std::move(snap);
+        snapshots.fetch_add(1, std::memory_order_relaxed);
+        lock.lock();
+        latest = std::move(r);
+        changed.notify_all();
+      } else {
+        lock.lock();
+        changed.wait_for(lock, kSamplePoll, [this] { return stopping; });
+      }
+    }
+    lock.unlock();
+    if (tj != nullptr) tjDestroy(tj);
+  }
+
+  // One Server-Sent Event per rendered snapshot; a comment line every second when nothing is
+  // new, so a client that went away is noticed. false ends the stream.
+  bool stream_next(std::uint64_t* last, httplib::DataSink& sink) {
+    std::shared_ptr<const Rendered> r;
+    {
+      std::unique_lock<std::mutex> lock(mutex);
+      changed.wait_for(lock, kStreamHeartbeat,
+                       [&] { return stopping || (latest && latest->seq != *last); });
+      if (stopping) return false;
+      r = latest;
+    }
+    std::string ev;
+    if (!r || r->seq == *last) {
+      ev = ": idle\n\n";
+    } else {
+      *last = r->seq;
+      ev = "event: state\nid: " + std::to_string(r->snapshot->cycle) + "\ndata: ";
+      ev += r->state_json;
+      ev += "\n\n";
+    }
+    if (!sink.write(ev.data(), ev.size())) {
+      dropped.fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    return true;
+  }
+
+  void routes();
+};
+
+void ViewServer::Impl::routes() {
+  using httplib::Request;
+  using httplib::Response;
+  const auto no_cycle = [](Response& res) {
+    res.status = 503;
+    res.set_content("{\"error\":\"no cycle yet\"}\n", "application/json");
+  };
+  server.Get("/", [this](const Request&, Response& res) {
+    const Asset& a = assets.at("index.html");
+    res.set_content(a.body, a.mime);
+  });
+  for (const AssetName& n : kAssets) {
+    if (assets.count(n.name) == 0) continue;
+    std::string pattern = std::string("/") + n.name;
+    for (std::size_t i = 0; (i = pattern.find('.', i)) != std::string::npos; i += 2)
+      pattern.insert(i, "\\");
+    const Asset* a = &assets.at(n.name);
+    server.Get(pattern, [a](const Request&, Response& res) { res.set_content(a->body, a->mime); });
+  }
+  server.Get("/api/state", [this, no_cycle](const Request&, Response& res) {
+    const auto r = current();
+    if (!r) return no_cycle(res);
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(r->state_json, "application/json");
+  });
+  server.Get("/api/fields", [this, no_cycle](const Request&, Response& res) {
+    const auto r = current();
+    if (!r) return no_cycle(res);
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(view_fields_json(*r->snapshot), "application/json");
+  });
+  server.Get(R"(/api/image/(left|right)\.jpg)",
+             [this, no_cycle](const Request& req, Response& res) {
+               const std::size_t s = req.matches[1] == "left" ? 0 : 1;
+               const auto r = current();
+               if (!r) return no_cycle(res);
+               if (r->jpeg[s].empty()) {
+                 res.status = 404;
+                 res.set_content("no such sensor on this board\n", "text/plain");
+                 return;
+               }
+               res.set_header("Cache-Control", "no-store");
+               res.set_header("X-Cycle", std::to_string(r->snapshot->cycle));
+               res.set_content(r->jpeg[s], "image/jpeg");
+             });
+  server.Get("/api/stream", [this](const Request&, Response& res) {
+    if (streams.fetch_add(1) >= config.max_streams) {
+      streams.fetch_sub(1);
+      refused.fetch_add(1, std::memory_order_relaxed);
+      res.status = 503;
+      res.set_content("too many streams open\n", "text/plain");
+      return;
+    }
+    res.set_header("Cache-Control", "no-store");
+    res.set_chunked_content_provider(
+        "text/event-stream",
+        [this, last = std::uint64_t{0}](std::size_t, httplib::DataSink& sink) mutable {
+          return stream_next(&last, sink);
+        },
+        [this](bool) { streams.fetch_sub(1); });
+  });
+}
+
+std::filesystem::path find_viewer_assets(const std::filesystem::path& exe_dir) {
+  const std::filesystem::path dir = exe_dir / ".." / "share" / "tacse3" / "viewer";
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(dir / "index.html", ec)) return {};
+  return std::filesystem::weakly_canonical(dir, ec);
+}
+
+ViewServer::ViewServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, ViewSlot& slot,
+                                              std::string* error) {
+  auto impl = std::make_unique<Impl>(config, slot);
+  for (const AssetName& n : kAssets) {
+    std::string body;
+    if (read_file(config.assets / n.name, &body)) {
+      impl->assets.emplace(n.name, Asset{std::move(body), n.mime});
+    } else if (n.required) {
+      *error = "viewer asset " + (config.assets / n.name).string() + " cannot be read";
+      return nullptr;
+    }
+  }
+  httplib::Server& sv = impl->server;
+  const int threads = config.threads;
+  sv.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
+  // SO_REUSEADDR only: a restart binds at once, but a second daemon on the same port fails
+  // (httplib's default adds SO_REUSEPORT, which would let both listen).
+  sv.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
+  sv.set_keep_alive_max_count(1000);
+  sv.set_keep_alive_timeout(2);
+  sv.set_read_timeout(2, 0);
+  sv.set_write_timeout(config.write_timeout_ms / 1000, (config.write_timeout_ms % 1000) * 1000);
+  sv.set_payload_max_length(4096);  // GET only: no request body is ever needed
+  impl->routes();
+  errno = 0;
+  if (!sv.bind_to_port(config.listen.host, config.listen.port)) {
+    const int e = errno;
+    *error = config.listen.host + ":" + std::to_string(config.listen.port) + ": cannot listen: " +
+             (e == EADDRINUSE ? std::string("address already in use (another program serves this "
+                                            "port; choose another)")
+              : e != 0        ? std::string(std::strerror(e))
+                              : std::string("bind failed"));
+    return nullptr;
+  }
+  Impl* p = impl.get();
+  p->sampler = std::thread([p] { p->sample_loop(); });
+  p->listener = std::thread([p] {
+    lower_priority(p->config.nice);  // before the pool threads exist: they inherit it
+    p->server.listen_after_bind();
+  });
+  // stop() only stops a server that is running: wait for it, so the destructor cannot miss it.
+  for (int i = 0; i < 1000 && !p->server.is_running(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  return std::unique_ptr<ViewServer>(new ViewServer(std::move(impl)));
+}
+
+ViewServer::~ViewServer() {
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->stopping = true;
+  }
+  impl_->changed.notify_all();
+  impl_->server.stop();
+  if (impl_->listener.joinable()) impl_->listener.join();
+  if (impl_->sampler.joinable()) impl_->sampler.join();
+}
+
+ViewServer::Stats ViewServer::stats() const noexcept {
+  Stats s;
+  s.snapshots = impl_->snapshots.load(std::memory_order_relaxed);
+  s.streams_refused = impl_->refused.load(std::memory_order_relaxed);
+  s.streams_dropped = impl_->dropped.load(std::memory_order_relaxed);
+  return s;
+}
+
+}  // namespace tacse3::firmware

@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3d live view: reads /api/stream (Server-Sent Events), /api/fields and the pads' JPEGs
+// (docs/viewer.md) and draws them. Read-only: it sends nothing but GET requests.
+'use strict';
+
+const WINDOW_S = 10;       // rolling plots
+const IMAGE_PERIOD_MS = 200;  // images and fields at 5 Hz; the scalars at the stream's rate
+const PADS = ['left', 'right'];
+const $ = (id) => document.getElementById(id);
+const fmt = (x, d) => (x === null || x === undefined || !isFinite(x) ? '-' : x.toFixed(d));
+
+// --- pose: angle and axis of the unit quaternion [w, x, y, z], in degrees ---
+function angleAxis(q) {
+  let [w, x, y, z] = q;
+  if (w < 0) { w = -w; x = -x; y = -y; z = -z; }  // the short way round
+  const s = Math.hypot(x, y, z);
+  const angle = 2 * Math.atan2(s, w) * 180 / Math.PI;
+  return s < 1e-12 ? { angle: 0, axis: [0, 0, 1] } : { angle, axis: [x / s, y / s, z / s] };
+}
+
+// --- plots ---
+const series = { t: [], w: [[], [], []], v: [[], [], []], rot: [[], [], []], area: [[], []],
+                 conf: [], dsp: [], latency: [] };
+const plots = [];
+function makePlot(el, title, labels, columns, unit) {
+  if (typeof uPlot === 'undefined') return;
+  const colours = ['#c0392b', '#27ae60', '#2471a3'];
+  const opts = {
+    title, width: 460, height: 180,
+    scales: { x: { time: false } },
+    axes: [{ label: 's' }, { label: unit }],
+    series: [{}].concat(labels.map((l, i) => ({ label: l, stroke: colours[i % 3], width: 1.5 }))),
+  };
+  plots.push({ plot: new uPlot(opts, [[]].concat(labels.map(() => [])), el), columns });
+}
+function setupPlots() {
+  if (typeof uPlot === 'undefined') { $('plots-missing').hidden = false; return; }
+  makePlot($('plot-w'), 'angular twist ω', ['x', 'y', 'z'], () => series.w, 'deg/s');
+  makePlot($('plot-v'), 'linear twist v', ['x', 'y', 'z'], () => series.v, 'mm/s');
+  makePlot($('plot-angles'), 'pose rotation vector', ['x', 'y', 'z'], () => series.rot, 'deg');
+  makePlot($('plot-area'), 'contact area', ['left', 'right'], () => series.area, 'mm²');
+  makePlot($('plot-conf'), 'confidence', ['confidence'], () => [series.conf], '');
+  makePlot($('plot-timing'), 'timing', ['dsp', 'latency'], () => [series.dsp, series.latency],
+           'µs');
+}
+function record(s) {
+  const t = s.t_us / 1e6;
+  const deg = 180 / Math.PI;
+  const aa = angleAxis(s.pose.q);
+  const push = (arr, v) => arr.push(v === null ? null : v);
+  series.t.push(t);
+  for (let i = 0; i < 3; i++) {
+    push(series.w[i], s.twist.w[i] === null ? null : s.twist.w[i] * deg);
+    push(series.v[i], s.twist.v[i] === null ? null : s.twist.v[i] * 1e3);
+    series.rot[i].push(aa.angle * aa.axis[i]);
+  }
+  PADS.forEach((p, i) => series.area[i].push(s.sensors[p].contact_area_m2 * 1e6));
+  push(series.conf, s.confidence);
+  series.dsp.push(s.dsp_us < 0 ? null : s.dsp_us);
+  series.latency.push(s.latency_us < 0 ? null : s.latency_us);
+  // Keep the last WINDOW_S seconds.
+  let drop = 0;
+  while (drop < series.t.length && series.t[drop] < t - WINDOW_S) drop++;
+  if (drop > 0) {
+    const cut = (a) => a.splice(0, drop);
+    cut(series.t); series.w.forEach(cut); series.v.forEach(cut); series.rot.forEach(cut);
+    series.area.forEach(cut); cut(series.conf); cut(series.dsp); cut(series.latency);
+  }
+}
+function redrawPlots() {
+  for (const p of plots) p.plot.setData([series.t].concat(p.columns()));
+}
+
+// --- scalars ---
+let last = null;
+function show(s) {
+  last = s;
+  const st = $('state');
+  st.textContent = s.state;
+  st.className = 'badge ' + ({ TRACKING: 'ok', NO_CONTACT: 'ok', FAULT: 'bad' }[s.state] || 'warn');
+  $('calibrated').hidden = s.calibrated;
+  $('cycle').textContent = s.cycle;
+  $('t').textContent = fmt(s.t_us / 1e6, 3);
+  $('confidence').textContent = fmt(s.confidence, 2);
+  $('dsp').textContent = s.dsp_us;
+  $('latency').textContent = s.latency_us;
+  const aa = angleAxis(s.pose.q);
+  $('angle').textContent = fmt(aa.angle, 2);
+  $('axis').textContent = '(' + aa.axis.map((a) => fmt(a, 3)).join(', ') + ')';
+  $('position').textContent = '(' + s.pose.p.map((a) => fmt(a * 1e3, 2)).join(', ') + ')';
+  for (const p of PADS) {
+    const d = s.sensors[p];
+    const el = document.querySelector('#pad-' + p + ' .padstate');
+    el.textContent = !d.configured ? 'not on this board'
+      : `${d.health}  ${d.contact ? (d.slipping ? 'SLIP' : 'STICK') : 'no contact'}  ` +
+        `area ${fmt(d.contact_area_m2 * 1e6, 1)} mm²  tracked ${fmt(d.tracked_fraction * 100, 0)} %`;
+  }
+  record(s);
+}
+
+// --- images and overlays ---
+const images = {};
+let fields = null;
+function drawPad(p) {
+  const canvas = document.querySelector('#pad-' + p + ' canvas');
+  const g = canvas.getContext('2d');
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  if (images[p]) g.drawImage(images[p], 0, 0, canvas.width, canvas.height);
+  if (!fields || !fields[p]) return;
+  const gw = fields.grid.width, gh = fields.grid.height;
+  const cw = canvas.width / gw, ch = canvas.height / gh;
+  const f = fields[p];
+  if ($('show-fz').checked) {
+    let max = 0;
+    for (const v of f.fz) max = Math.max(max, Math.abs(v));
+    if (max > 0) {
+      for (let i = 0; i < f.fz.length; i++) {
+        const a = Math.max(0, f.fz[i]) / max;
+        if (a <= 0.02) continue;
+        g.fillStyle = `rgba(255, ${Math.round(200 * (1 - a))}, 0, ${0.6 * a})`;
+        g.fillRect((i % gw) * cw, Math.floor(i / gw) * ch, cw, ch);
+      }
+    }
+  }
+  if ($('show-contact').checked) {
+    // The outline of Ω: every cell edge between a contact cell and a non-contact one.
+    g.strokeStyle = '#00e5ff';
+    g.lineWidth = 2;
+    g.beginPath();
+    const at = (x, y) => x >= 0 && y >= 0 && x < gw && y < gh && f.mask[y * gw + x] === 1;
+    for (let y = 0; y < gh; y++) {
+      for (let x = 0; x < gw; x++) {
+        if (!at(x, y)) continue;
+        const x0 = x * cw, y0 = y * ch;
+        if (!at(x, y - 1)) { g.moveTo(x0, y0); g.lineTo(x0 + cw, y0); }
+        if (!at(x, y + 1)) { g.moveTo(x0, y0 + ch); g.lineTo(x0 + cw, y0 + ch); }
+        if (!at(x - 1, y)) { g.moveTo(x0, y0); g.lineTo(x0, y0 + ch); }
+        if (!at(x + 1, y)) { g.moveTo(x0 + cw, y0); g.lineTo(x0 + cw, y0 + ch); }
+      }
+    }
+    g.stroke();
+  }
+  if ($('show-shear').checked) {
+    // Every second grid point; arrows scaled so the largest spans two grid cells.
+    let max = 0;
+    for (let i = 0; i < f.shear_x.length; i++) max = Math.max(max, Math.hypot(f.shear_x[i], f.shear_y[i]));
+    if (max > 0) {
+      const k = 2 * cw / max;
+      g.strokeStyle = '#ffeb3b';
+      g.lineWidth = 1.2;
+      g.beginPath();
+      for (let y = 0; y < gh; y += 2) {
+        for (let x = 0; x < gw; x += 2) {
+          const i = y * gw + x;
+          const dx = f.shear_x[i] * k, dy = f.shear_y[i] * k;
+          if (Math.hypot(dx, dy) < 1.5) continue;
+          const x0 = (x + 0.5) * cw, y0 = (y + 0.5) * ch;
+          g.moveTo(x0, y0);
+          g.lineTo(x0 + dx, y0 + dy);
+          const a = Math.atan2(dy, dx);
+          g.lineTo(x0 + dx - 4 * Math.cos(a - 0.5), y0 + dy - 4 * Math.sin(a - 0.5));
+        }
+      }
+      g.stroke();
+    }
+  }
+}
+async function refreshImages() {
+  try {
+    const r = await fetch('api/fields', { cache: 'no-store' });
+    if (r.ok) fields = await r.json();
+    for (const p of PADS) {
+      if (last && !last.sensors[p].configured) continue;
+      const ir = await fetch('api/image/' + p + '.jpg', { cache: 'no-store' });
+      if (ir.ok) images[p] = await createImageBitmap(await ir.blob());
+    }
+  } catch (e) { /* the daemon went away: the stream badge says so */ }
+  PADS.forEach(drawPad);
+  setTimeout(refreshImages, IMAGE_PERIOD_MS);
+}
+
+// --- stream ---
+function connect() {
+  const es = new EventSource('api/stream');
+  es.addEventListener('state', (ev) => {
+    $('link').textContent = 'live';
+    $('link').className = 'badge ok';
+    show(JSON.parse(ev.data));
+  });
+  es.onerror = () => {
+    $('link').textContent = 'stream lost, retrying';
+    $('link').className = 'badge bad';
+  };
+}
+
+setupPlots();
+connect();
+refreshImages();
+setInterval(redrawPlots, 100);
+for (const id of ['show-shear', 'show-contact', 'show-fz'])
+  $(id).addEventListener('change', () => PADS.forEach(drawPad));
+window.tacse3 = { series, last: () => last, plots: () => plots.length };  // for the browser test

@@ -1,0 +1,247 @@
+// SPDX-License-Identifier: Apache-2.0
+// firmware tests: tacse3d --http on the sim board, through real sockets: /api/state holds a live
+// cycle (counting up, unit quaternion, a known state), the pads' JPEGs decode to real images,
+// /api/stream delivers events, and the CAN stream keeps its rate while four clients are
+// connected, one of which never reads. Plus the usage and start errors of --http.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <turbojpeg.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bus_events.hpp"
+#include "run_cmd.hpp"
+
+namespace fs = std::filesystem;
+using tacse3::test::read_all;
+using tacse3::test::run_cmd;
+using tacse3::test::RunResult;
+
+namespace {
+
+// A port nobody listens on now (the kernel's pick for port 0).
+int free_port() {
+  const int s = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(s, reinterpret_cast<sockaddr*>(&a), sizeof(a));
+  socklen_t n = sizeof(a);
+  getsockname(s, reinterpret_cast<sockaddr*>(&a), &n);
+  close(s);
+  return ntohs(a.sin_port);
+}
+
+// The number after "key": in a flat JSON text (the fields used here are unique keys).
+double json_number(const std::string& j, const std::string& key, std::size_t from = 0) {
+  const std::size_t at = j.find("\"" + key + "\":", from);
+  if (at == std::string::npos) return NAN;
+  return std::strtod(j.c_str() + at + key.size() + 3, nullptr);
+}
+
+std::string json_string(const std::string& j, const std::string& key) {
+  const std::size_t at = j.find("\"" + key + "\":\"");
+  if (at == std::string::npos) return {};
+  const std::size_t b = at + key.size() + 4;
+  return j.substr(b, j.find('"', b) - b);
+}
+
+std::vector<double> json_array(const std::string& j, const std::string& key) {
+  std::vector<double> v;
+  std::size_t at = j.find("\"" + key + "\":[");
+  if (at == std::string::npos) return v;
+  const char* p = j.c_str() + at + key.size() + 4;
+  while (*p != ']' && *p != '\0') {
+    char* end = nullptr;
+    v.push_back(std::strtod(p, &end));
+    p = *end == ',' ? end + 1 : end;
+  }
+  return v;
+}
+
+class ViewerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("tacse3-fw-viewer-" + std::to_string(getpid()));
+    fs::create_directories(dir_);
+    // The sim board unpaced, with stale/lost raised, as in test_run.cpp: the shared machine must
+    // not turn the rate check into a single-sensor run.
+    std::string text = read_all(fs::path(TACSE3_SOURCE_BOARDS_DIR) / "sim/board.toml");
+    text.replace(text.find("realtime = true"), 15, "realtime = false");
+    text.replace(text.find("stale_ms = 50"), 13, "stale_ms = 1000");
+    text.replace(text.find("lost_ms = 500"), 13, "lost_ms = 2000");
+    std::ofstream(dir_ / "board.toml") << text;
+    port_ = free_port();
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string daemon(const std::string& http, int seconds) const {
+    return std::string(TACSE3D_BIN) + " --board " + (dir_ / "board.toml").string() +
+           " --calibration " + TACSE3_SIM_CALIBRATION + " --can-log " +
+           (dir_ / "bus.log").string() + " --http " + http + " --seconds " +
+           std::to_string(seconds) + " 2>&1";
+  }
+
+  fs::path dir_;
+  int port_ = 0;
+};
+
+}  // namespace
+
+TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) {
+  RunResult d;
+  std::thread run([&] { d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 6)); });
+  httplib::Client cli("127.0.0.1", port_);
+  cli.set_connection_timeout(1);
+  cli.set_read_timeout(2);
+  std::string first;
+  for (int i = 0; i < 100 && first.empty(); ++i) {
+    if (auto r = cli.Get("/api/state"); r && r->status == 200) {
+      first = r->body;
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  }
+  ASSERT_FALSE(first.empty()) << "no /api/state within 10 s";
+
+  // The client that never reads: its stream fills the socket buffers and must stall nothing.
+  const int mute = socket(AF_INET, SOCK_STREAM, 0);
+  const int small = 4096;
+  setsockopt(mute, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port_));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(connect(mute, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
+  const std::string req = "GET /api/stream HTTP/1.1\r\nHost: test\r\n\r\n";
+  ASSERT_EQ(send(mute, req.data(), req.size(), 0), static_cast<ssize_t>(req.size()));
+
+  // Three reading clients on the stream.
+  std::atomic<bool> stop{false};
+  std::vector<std::vector<long long>> ids(3);
+  std::vector<std::thread> readers;
+  for (int k = 0; k < 3; ++k) {
+    readers.emplace_back([&, k] {
+      httplib::Client c("127.0.0.1", port_);
+      c.set_read_timeout(3);
+      std::string buf;
+      c.Get("/api/stream", [&](const char* data, std::size_t n) {
+        buf.append(data, n);
+        for (std::size_t at; (at = buf.find("\n\n")) != std::string::npos; buf.erase(0, at + 2)) {
+          const std::size_t id = buf.find("id: ");
+          if (id < at) ids[k].push_back(std::stoll(buf.substr(id + 4)));
+        }
+        return !stop.load();
+      });
+    });
+  }
+
+  // Two fetches 300 ms apart: the cycle counts up, the pose is a unit quaternion.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  auto second = cli.Get("/api/state");
+  ASSERT_TRUE(second && second->status == 200);
+  const std::string& s = second->body;
+  EXPECT_GT(json_number(s, "cycle"), json_number(first, "cycle"));
+  EXPECT_GT(json_number(s, "t_us"), json_number(first, "t_us"));
+  const std::set<std::string> states{"BOOTING", "NO_CONTACT", "TRACKING", "DEGRADED_SINGLE_SENSOR",
+                                     "FAULT"};
+  EXPECT_EQ(states.count(json_string(s, "state")), 1u) << s;
+  const std::vector<double> q = json_array(s, "q");
+  ASSERT_EQ(q.size(), 4u) << s;
+  EXPECT_NEAR(std::hypot(std::hypot(q[0], q[1]), std::hypot(q[2], q[3])), 1.0, 1e-6) << s;
+  EXPECT_EQ(json_array(s, "w").size(), 3u);
+  EXPECT_EQ(json_array(s, "p").size(), 3u);
+  const double conf = json_number(s, "confidence");
+  EXPECT_TRUE(conf >= 0.0 && conf <= 1.0) << s;
+  EXPECT_NE(s.find("\"left\":{\"configured\":true"), std::string::npos) << s;
+
+  // Both images decode to 160 x 120 grey with the gel's texture in them.
+  tjhandle tj = tjInitDecompress();
+  for (const char* pad : {"left", "right"}) {
+    auto r = cli.Get(std::string("/api/image/") + pad + ".jpg");
+    ASSERT_TRUE(r && r->status == 200) << pad;
+    EXPECT_EQ(r->get_header_value("Content-Type"), "image/jpeg");
+    int w = 0, h = 0, sub = 0, cs = 0;
+    const auto* jpg = reinterpret_cast<const unsigned char*>(r->body.data());
+    ASSERT_EQ(tjDecompressHeader3(tj, jpg, r->body.size(), &w, &h, &sub, &cs), 0) << pad;
+    ASSERT_EQ(w, 160);
+    ASSERT_EQ(h, 120);
+    std::vector<unsigned char> px(static_cast<std::size_t>(w * h));
+    ASSERT_EQ(tjDecompress2(tj, jpg, r->body.size(), px.data(), w, 0, h, TJPF_GRAY, 0), 0);
+    double sum = 0, sum2 = 0;
+    for (unsigned char v : px) {
+      sum += v;
+      sum2 += static_cast<double>(v) * v;
+    }
+    const double mean = sum / px.size();
+    const double sd = std::sqrt(sum2 / px.size() - mean * mean);
+    EXPECT_GT(sd, 5.0) << pad << ": a blank image (mean " << mean << ")";
+  }
+  tjDestroy(tj);
+  auto fields = cli.Get("/api/fields");
+  ASSERT_TRUE(fields && fields->status == 200);
+  EXPECT_EQ(json_array(fields->body, "mask").size(), 1200u);
+  EXPECT_EQ(cli.Get("/etc/passwd")->status, 404);
+  EXPECT_EQ(cli.Get("/api/image/../../x.jpg")->status, 404);
+
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  stop.store(true);
+  for (auto& t : readers) t.join();
+  run.join();
+  close(mute);
+  ASSERT_EQ(d.status, 0) << "the daemon did not stop cleanly with a client that never reads\n"
+                         << d.out;
+  EXPECT_NE(d.out.find("viewer: http://127.0.0.1:" + std::to_string(port_) + "/"),
+            std::string::npos)
+      << d.out;
+  for (const auto& v : ids) {
+    // ~1.8 s of stream at 20 Hz; at least a few events, in order, none repeated.
+    EXPECT_GE(v.size(), 5u);
+    for (std::size_t i = 1; i < v.size(); ++i) EXPECT_GT(v[i], v[i - 1]);
+  }
+
+  // The CAN stream with the clients connected: every frame pair one cycle, at the sensor rate
+  // (the same bound as test_run.cpp's run without the viewer).
+  tacse3::test::BusEvents b;
+  ASSERT_TRUE(b.feed_log(read_all(dir_ / "bus.log")));
+  ASSERT_GE(b.cycles.size(), 240u);
+  const double t0 = static_cast<double>(b.cycles.front().timestamp_us);
+  const double t1 = static_cast<double>(b.cycles.back().timestamp_us);
+  const double rate = static_cast<double>(b.cycles.size() - 1) / ((t1 - t0) * 1e-6);
+  EXPECT_NEAR(rate, 120.0, 1.2) << "cycle rate " << rate << " Hz";
+}
+
+TEST_F(ViewerTest, BadAddressIsAUsageErrorAndABusyPortAStartError) {
+  for (const char* bad : {"127.0.0.1:0", "127.0.0.1:99999", "board:80", "x"}) {
+    const RunResult r = run_cmd(daemon(bad, 1));
+    EXPECT_EQ(r.status, 2) << bad << "\n" << r.out;
+    EXPECT_NE(r.out.find("--http \""), std::string::npos) << r.out;
+  }
+  // Someone else listens on the port.
+  const int s = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port_));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(s, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
+  ASSERT_EQ(listen(s, 1), 0);
+  const RunResult r = run_cmd(daemon(std::to_string(port_), 1));
+  close(s);
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("--http " + std::to_string(port_) + ": 127.0.0.1:" + std::to_string(port_) +
+                       ": cannot listen: address already in use"),
+            std::string::npos)
+      << r.out;
+}
