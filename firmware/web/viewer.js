@@ -43,8 +43,10 @@ function setupPlots() {
   makePlot($('plot-timing'), 'timing', ['dsp', 'latency'], () => [series.dsp, series.latency],
            'µs');
 }
+let t0_us = null;  // the plots' time axis: seconds since the page's first snapshot
 function record(s) {
-  const t = s.t_us / 1e6;
+  if (t0_us === null) t0_us = s.t_us;
+  const t = (s.t_us - t0_us) / 1e6;
   const deg = 180 / Math.PI;
   const aa = angleAxis(s.pose.q);
   const push = (arr, v) => arr.push(v === null ? null : v);

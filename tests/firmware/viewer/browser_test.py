@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""tacse3d's live view in headless Chromium (Debian's chromium, chromium-driver, python3-selenium).
+
+Starts tacse3d --board BOARD --http 127.0.0.1:PORT, loads the page and checks that the stream is
+live, the plots move, both pad canvases show an image (not blank), the overlays draw, and the
+pose readout is the angle of the page's own last snapshot. Saves a screenshot to --screenshot.
+Exit 77 (ctest: skipped) with a message when Chromium, its driver or selenium is missing.
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+
+SKIP = 77
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for(what, fn, timeout_s):
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        value = fn()
+        if value:
+            return value
+        time.sleep(0.1)
+    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+
+
+# Standard deviation of a canvas's luma (the image with its overlays), computed in the page.
+CANVAS_SD = """
+const c = document.querySelector('#pad-' + arguments[0] + ' canvas');
+const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+let s = 0, s2 = 0, n = d.length / 4;
+for (let i = 0; i < d.length; i += 4) {
+  const y = 0.299 * d[i] + 0.587 * d[i + 1] + 0.114 * d[i + 2];
+  s += y; s2 += y * y;
+}
+const m = s / n;
+return Math.sqrt(Math.max(0, s2 / n - m * m));
+"""
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--tacse3d", required=True)
+    ap.add_argument("--board", required=True, help="the sim board.toml (looped here)")
+    ap.add_argument("--calibration", required=True)
+    ap.add_argument("--screenshot", required=True)
+    args = ap.parse_args()
+
+    chromium = shutil.which("chromium")
+    driver = shutil.which("chromedriver")
+    try:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.options import Options
+        from selenium.webdriver.chrome.service import Service
+    except ImportError:
+        webdriver = None
+    if not chromium or not driver or webdriver is None:
+        print("browser test skipped: needs Debian's chromium, chromium-driver and python3-selenium "
+              "(scripts/setup.sh installs them)")
+        return SKIP
+
+    # The sim board looping its scenario, so the plots keep moving however long the browser takes.
+    board = args.screenshot + ".board.toml"
+    with open(args.board) as f:
+        text = f.read()
+    assert "repeat = false" in text, f"{args.board}: no 'repeat = false' to turn on"
+    with open(board, "w") as f:
+        f.write(text.replace("repeat = false", "repeat = true"))
+
+    port = free_port()
+    base = f"http://127.0.0.1:{port}"
+    log = open(args.screenshot + ".tacse3d.log", "w")
+    daemon = subprocess.Popen([args.tacse3d, "--board", board, "--calibration",
+                               args.calibration, "--can-log", os.devnull, "--http",
+                               f"127.0.0.1:{port}", "--seconds", "60"],
+                              stdout=subprocess.DEVNULL, stderr=log)
+    browser = None
+    try:
+        def state():
+            try:
+                with urllib.request.urlopen(base + "/api/state", timeout=1) as r:
+                    return json.loads(r.read())
+            except OSError:
+                return None
+        wait_for("/api/state", state, 15)
+
+        opts = Options()
+        opts.binary_location = chromium
+        for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1500,1400",
+                  "--disable-dev-shm-usage"):
+            opts.add_argument(a)
+        browser = webdriver.Chrome(service=Service(driver), options=opts)
+        browser.get(base + "/")
+        js = browser.execute_script
+
+        wait_for("the stream", lambda: js("return document.getElementById('link').textContent")
+                 == "live", 10)
+        assert js("return document.getElementById('plots-missing').hidden"), \
+            "the page says the plots are missing (uPlot not bundled)"
+        assert js("return window.tacse3.plots()") == 6, "not every plot was created"
+
+        # The plots move: more samples, and the ω plot's pixels change.
+        plot_png = "return document.querySelector('#plot-w canvas').toDataURL()"
+        n0 = js("return window.tacse3.series.t.length")
+        img0 = js(plot_png)
+        time.sleep(2.0)
+        n1 = js("return window.tacse3.series.t.length")
+        assert n1 >= n0 + 20, f"the plots got {n1 - n0} samples in 2 s (20 Hz expected)"
+        assert js(plot_png) != img0, "the angular-twist plot did not change in 2 s"
+
+        # Both pads show an image, with the contact overlays on.
+        for pad in ("left", "right"):
+            sd = wait_for(f"the {pad} image", lambda: (lambda v: v if v > 5 else 0)(
+                js(CANVAS_SD, pad)), 5)
+            print(f"{pad} canvas: luma standard deviation {sd:.1f}")
+        text = js("return document.querySelector('#pad-left .padstate').textContent")
+        assert text.startswith("OK"), f"left pad state reads {text!r}"
+
+        # The pose readout is the angle of the page's last snapshot's quaternion.
+        # (One script: a new event may arrive between two calls.)
+        snap, shown = js("return [window.tacse3.last(), "
+                         "document.getElementById('angle').textContent]")
+        w = abs(snap["pose"]["q"][0])
+        angle = 2 * math.degrees(math.acos(min(1.0, w)))
+        assert abs(float(shown) - angle) < 0.02, f"angle shown {shown}, snapshot {angle:.3f}"
+
+        browser.save_screenshot(args.screenshot)
+        print(f"screenshot: {args.screenshot}")
+        return 0
+    finally:
+        if browser is not None:
+            browser.quit()
+        daemon.terminate()
+        daemon.wait(timeout=20)
+        log.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
