@@ -70,6 +70,13 @@ foreach(board_file IN LISTS _tacse3_pkg_boards)
   install(FILES "${board_file}" DESTINATION "${CMAKE_INSTALL_DATADIR}/tacse3/boards/${board}"
           COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
 endforeach()
+# The live view's page (docs/viewer.md): /usr/share/tacse3/viewer, the daemon's
+# <exe_dir>/../share lookup, when this tacse3d is built with the viewer.
+if(TARGET tacse3_viewer_assets)
+  install(DIRECTORY "${TACSE3_VIEWER_DIR}/" DESTINATION "${CMAKE_INSTALL_DATADIR}/tacse3/viewer"
+          COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
+  add_dependencies(tacse3_package_programs tacse3_viewer_assets)
+endif()
 # The simulator's calibration: tacse3d --board sim and tacse3-replay of a simulator recording
 # use it when no --calibration is given (config::find_sim_calibration).
 install(FILES "${PROJECT_SOURCE_DIR}/tools/replay/data/sim-calibration.toml"

@@ -125,7 +125,9 @@ function(tacse3_find_pkg target)
 
   set(includes ${${prefix}_INCLUDE_DIRS})
   if(CMAKE_CROSSCOMPILING)
-    list(APPEND includes "${sysroot}/usr/include")
+    # The multiarch folder too: the native compiler searches /usr/include/<triple> by itself, the
+    # cross one not in the sysroot (OpenSSL's opensslconf.h, which cpp-httplib's header reaches).
+    list(APPEND includes "${sysroot}/usr/include" "${sysroot}/usr/include/${multiarch}")
   endif()
   list(REMOVE_DUPLICATES includes)
 

@@ -37,6 +37,8 @@ DEBS="$PWD/build/sysroot/.debs-$DIR_NAME"
 TOP=(libgpiod-dev libgpiod2 libturbojpeg0-dev libturbojpeg0)  # libgpiod2 ships libgpiodcxx.so.1
 # Recording format (recording/, the replay/calibrate tools, tacse3d --record).
 TOP+=(libspng-dev libspng0)
+# The daemon's live view (tacse3d --http): cpp-httplib, a shared library in Debian.
+TOP+=(libcpp-httplib-dev libcpp-httplib0.11)
 # The daemon's sd_notify (READY=1, WATCHDOG=1).
 TOP+=(libsystemd-dev libsystemd0)
 if [ "$WITH_LIBCAMERA" = 1 ]; then TOP+=(libcamera-dev libcamera0.0.3); fi
@@ -152,7 +154,7 @@ done < <(find "$SYSROOT" -type l -print0)
 } >"$SYSROOT/.tacse3-sysroot"
 rm -f "$SYSROOT/.tacse3-sysroot.tmp"
 missing=0
-for lib in libgpiodcxx.so libturbojpeg.so libspng.so libsystemd.so libcamera.so; do
+for lib in libgpiodcxx.so libturbojpeg.so libspng.so libsystemd.so libcpp-httplib.so libcamera.so; do
   if [ -e "$SYSROOT/usr/lib/$TRIPLE/$lib" ]; then
     echo "  found $lib"
   elif [ "$lib" != libcamera.so ] || [ "$WITH_LIBCAMERA" = 1 ]; then

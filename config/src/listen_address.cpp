@@ -8,6 +8,17 @@
 
 namespace tacse3::config {
 
+namespace {
+
+// "\"TEXT\": what" (built with append: GCC 12 -O3 warns on "literal" + std::string).
+std::string problem(std::string_view text, const char* what) {
+  std::string e(1, '"');
+  e.append(text).append("\": ").append(what);
+  return e;
+}
+
+}  // namespace
+
 bool parse_listen_address(std::string_view text, ListenAddress* out, std::string* error) {
   const std::size_t colon = text.rfind(':');
   std::string host = "127.0.0.1";  // a port alone never exposes the board to the network
@@ -18,8 +29,7 @@ bool parse_listen_address(std::string_view text, ListenAddress* out, std::string
     if (host == "localhost") host = "127.0.0.1";
     in_addr a{};
     if (host.empty() || inet_pton(AF_INET, host.c_str(), &a) != 1) {
-      *error = "\"" + std::string(text) +
-               "\": the address must be an IPv4 address such as 127.0.0.1 or 0.0.0.0";
+      *error = problem(text, "the address must be an IPv4 address such as 127.0.0.1 or 0.0.0.0");
       return false;
     }
   }
@@ -28,7 +38,7 @@ bool parse_listen_address(std::string_view text, ListenAddress* out, std::string
       std::from_chars(port_text.data(), port_text.data() + port_text.size(), port);
   if (port_text.empty() || ec != std::errc() || end != port_text.data() + port_text.size() ||
       port < 1 || port > 65535) {
-    *error = "\"" + std::string(text) + "\": the port must be a number in 1..65535";
+    *error = problem(text, "the port must be a number in 1..65535");
     return false;
   }
   out->host = host;

@@ -155,7 +155,9 @@ struct ViewServer::Impl {
       ev = ": idle\n\n";
     } else {
       *last = r->seq;
-      ev = "event: state\nid: " + std::to_string(r->snapshot->cycle) + "\ndata: ";
+      ev = "event: state\nid: ";
+      ev += std::to_string(r->snapshot->cycle);
+      ev += "\ndata: ";
       ev += r->state_json;
       ev += "\n\n";
     }
@@ -182,9 +184,11 @@ void ViewServer::Impl::routes() {
   });
   for (const AssetName& n : kAssets) {
     if (assets.count(n.name) == 0) continue;
-    std::string pattern = std::string("/") + n.name;
-    for (std::size_t i = 0; (i = pattern.find('.', i)) != std::string::npos; i += 2)
-      pattern.insert(i, "\\");
+    std::string pattern = "/";  // the route is a regular expression: escape the dots
+    for (const char* c = n.name; *c != '\0'; ++c) {
+      if (*c == '.') pattern += '\\';
+      pattern += *c;
+    }
     const Asset* a = &assets.at(n.name);
     server.Get(pattern, [a](const Request&, Response& res) { res.set_content(a->body, a->mime); });
   }
@@ -249,7 +253,8 @@ std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, Vi
     if (read_file(config.assets / n.name, &body)) {
       impl->assets.emplace(n.name, Asset{std::move(body), n.mime});
     } else if (n.required) {
-      *error = "viewer asset " + (config.assets / n.name).string() + " cannot be read";
+      *error = std::string("viewer asset ").append((config.assets / n.name).string());
+      *error += " cannot be read";
       return nullptr;
     }
   }
