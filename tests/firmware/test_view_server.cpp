@@ -1,0 +1,261 @@
+// SPDX-License-Identifier: Apache-2.0
+// firmware tests: the viewer's HTTP server in-process on a synthetic snapshot: the exact JSON of
+// /api/state, the answers to a table of well-formed, hostile and malformed raw requests, the
+// stream's events and its client limit.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tacse3/firmware/view_json.hpp"
+#include "tacse3/firmware/view_server.hpp"
+#include "tacse3/protocol/types.hpp"
+
+namespace fs = std::filesystem;
+using namespace tacse3;
+using namespace tacse3::firmware;
+
+namespace {
+
+int free_port() {
+  const int s = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(s, reinterpret_cast<sockaddr*>(&a), sizeof(a));
+  socklen_t n = sizeof(a);
+  getsockname(s, reinterpret_cast<sockaddr*>(&a), &n);
+  close(s);
+  return ntohs(a.sin_port);
+}
+
+int connect_to(int port) {
+  const int s = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<std::uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(s, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
+    close(s);
+    return -1;
+  }
+  timeval tv{3, 0};
+  setsockopt(s, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+  return s;
+}
+
+// Sends `request` as is on a new connection and returns everything the server sent until it
+// closed the connection (requests here say "Connection: close") or 3 s passed.
+std::string exchange(int port, const std::string& request) {
+  const int s = connect_to(port);
+  if (s < 0) return {};
+  send(s, request.data(), request.size(), MSG_NOSIGNAL);
+  std::string out;
+  char buf[4096];
+  for (ssize_t n; (n = recv(s, buf, sizeof(buf), 0)) > 0;) out.append(buf, static_cast<size_t>(n));
+  close(s);
+  return out;
+}
+
+int status_of(const std::string& response) {
+  if (response.rfind("HTTP/1.1 ", 0) != 0) return -1;
+  return std::atoi(response.c_str() + 9);
+}
+
+std::string body_of(const std::string& response) {
+  const std::size_t at = response.find("\r\n\r\n");
+  return at == std::string::npos ? std::string() : response.substr(at + 4);
+}
+
+std::string get(const std::string& path) {
+  return "GET " + path + " HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n";
+}
+
+void fill(ViewSnapshot* v, std::uint64_t cycle) {
+  *v = ViewSnapshot{};
+  v->cycle = cycle;
+  v->t_us = 123456;
+  v->state = static_cast<std::uint8_t>(protocol::State::kTracking);
+  v->have_result = true;
+  v->valid = true;
+  v->calibrated = true;
+  v->w = {0.5, -0.25, 0.0};
+  v->v = {0.001, std::numeric_limits<double>::quiet_NaN(), 0.0};
+  v->q = {0.5, 0.5, 0.5, 0.5};
+  v->p = {0.01, 0.0, -0.002};
+  v->confidence = 0.75;
+  v->dsp_us = 900;
+  v->latency_us = 4100;
+  ViewPad& l = v->pads[0];
+  l.configured = l.present = l.contact = true;
+  l.health = static_cast<std::uint8_t>(protocol::SensorHealth::kOk);
+  l.contact_area_m2 = 5e-5;
+  l.tracked_fraction = 0.5;
+  for (std::size_t i = 0; i < l.luma.size(); ++i) l.luma[i] = static_cast<std::uint8_t>(i * 7);
+  v->pads[1].health = static_cast<std::uint8_t>(protocol::SensorHealth::kNotAvailable);
+}
+
+class ViewServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    assets_ = fs::temp_directory_path() / ("tacse3-view-server-" + std::to_string(getpid()));
+    fs::create_directories(assets_);
+    std::ofstream(assets_ / "index.html") << "<p>page</p>";
+    std::ofstream(assets_ / "viewer.js") << "js";
+    std::ofstream(assets_ / "viewer.css") << "css";
+    config_.listen = {"127.0.0.1", free_port()};
+    config_.assets = assets_;
+    std::string e;
+    server_ = ViewServer::start(config_, slot_, &e);
+    ASSERT_TRUE(server_) << e;
+  }
+  void TearDown() override {
+    server_.reset();
+    fs::remove_all(assets_);
+  }
+  // Publishes a snapshot and waits until the server serves it.
+  void publish(std::uint64_t cycle) {
+    fill(&slot_.back(), cycle);
+    slot_.publish();
+    const std::string want = "\"cycle\":" + std::to_string(cycle) + ",";
+    for (int i = 0; i < 300; ++i) {
+      if (body_of(exchange(port(), get("/api/state"))).find(want) != std::string::npos) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    FAIL() << "cycle " << cycle << " not served within 3 s";
+  }
+  int port() const { return config_.listen.port; }
+
+  fs::path assets_;
+  ViewServerConfig config_;
+  ViewSlot slot_;
+  std::unique_ptr<ViewServer> server_;
+};
+
+}  // namespace
+
+TEST(ViewJson, StateIsTheDocumentedDocument) {
+  ViewSnapshot v;
+  fill(&v, 42);
+  EXPECT_EQ(view_state_json(v),
+            "{\"cycle\":42,\"t_us\":123456,\"state\":\"TRACKING\",\"valid\":true,"
+            "\"single_sensor\":false,\"calibrated\":true,"
+            "\"twist\":{\"w\":[0.5,-0.25,0],\"v\":[0.001,null,0]},"
+            "\"pose\":{\"q\":[0.5,0.5,0.5,0.5],\"p\":[0.01,0,-0.002]},\"confidence\":0.75,"
+            "\"dsp_us\":900,\"latency_us\":4100,\"sensors\":{"
+            "\"left\":{\"configured\":true,\"present\":true,\"health\":\"OK\",\"contact\":true,"
+            "\"slipping\":false,\"contact_area_m2\":5e-05,\"tracked_fraction\":0.5},"
+            "\"right\":{\"configured\":false,\"present\":false,\"health\":\"NOT_AVAILABLE\","
+            "\"contact\":false,\"slipping\":false,\"contact_area_m2\":0,\"tracked_fraction\":0}}}");
+  const std::string f = view_fields_json(v);
+  EXPECT_EQ(f.rfind("{\"cycle\":42,\"grid\":{\"width\":40,\"height\":30,\"image_width\":160,"
+                    "\"image_height\":120},\"left\":{\"mask\":[0,0,",
+                    0),
+            0u)
+      << f.substr(0, 200);
+}
+
+TEST_F(ViewServerTest, NothingButTheDocumentedEndpoints) {
+  EXPECT_EQ(status_of(exchange(port(), get("/api/state"))), 503) << "before the first snapshot";
+  publish(7);
+  struct Case {
+    std::string request;
+    int status;
+  };
+  const std::string long_uri = "/api/state?" + std::string(9000, 'a');
+  const std::vector<Case> cases = {
+      {get("/"), 200},
+      {get("/viewer.js"), 200},
+      {get("/viewer.css"), 200},
+      {get("/api/state"), 200},
+      {get("/api/state?x=1"), 200},
+      {get("/api/fields"), 200},
+      {get("/api/image/left.jpg"), 200},
+      {get("/api/image/right.jpg"), 404},  // not configured in the snapshot
+      {get("/api/image/centre.jpg"), 404},
+      {get("/api/image/left.jpgx"), 404},
+      {get("/viewerXjs"), 404},          // the dot is literal
+      {get("/uPlot.iife.min.js"), 404},  // an optional asset that is absent
+      {get("/index.html/../../etc/passwd"), 404},
+      {get("/%2e%2e/%2e%2e/etc/passwd"), 404},
+      {get("/api/../../etc/passwd"), 404},
+      {"POST /api/state HTTP/1.1\r\nHost: t\r\nContent-Length: 2\r\nConnection: close\r\n\r\n{}",
+       404},
+      {"PUT / HTTP/1.1\r\nHost: t\r\nContent-Length: 0\r\nConnection: close\r\n\r\n", 404},
+      {"DELETE /api/state HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n", 404},
+      {"BREW / HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n", 400},
+      {"GET / HTTP/9.9\r\nHost: t\r\nConnection: close\r\n\r\n", 400},
+      {"\x01\x02\x03 garbage\r\n\r\n", 400},
+      {get(long_uri), 414},
+      {"POST / HTTP/1.1\r\nHost: t\r\nContent-Length: 100000\r\nConnection: close\r\n\r\n", 413},
+  };
+  for (const Case& c : cases) {
+    const std::string r = exchange(port(), c.request);
+    EXPECT_EQ(status_of(r), c.status) << c.request.substr(0, 60) << "\n" << r.substr(0, 200);
+  }
+  const std::string page = exchange(port(), get("/"));
+  EXPECT_EQ(body_of(page), "<p>page</p>");
+  EXPECT_NE(page.find("Content-Type: text/html"), std::string::npos);
+  // Still serving after all that.
+  EXPECT_EQ(status_of(exchange(port(), get("/api/state"))), 200);
+}
+
+TEST_F(ViewServerTest, StreamsEverySnapshotAndRefusesAFifthClient) {
+  publish(1);
+  std::vector<int> streams;
+  for (int i = 0; i < config_.max_streams; ++i) {
+    streams.push_back(connect_to(port()));
+    const std::string req = get("/api/stream");
+    send(streams.back(), req.data(), req.size(), MSG_NOSIGNAL);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // all four are streaming
+  EXPECT_EQ(status_of(exchange(port(), get("/api/stream"))), 503);
+  EXPECT_EQ(server_->stats().streams_refused, 1u);
+  for (std::uint64_t c = 2; c <= 4; ++c) publish(c);
+  // The first stream got the snapshot it found and each one published after, in order.
+  std::string got;
+  char buf[4096];
+  for (int i = 0; i < 50 && got.find("id: 4\n") == std::string::npos; ++i) {
+    const ssize_t n = recv(streams[0], buf, sizeof(buf), 0);
+    if (n <= 0) break;
+    got.append(buf, static_cast<size_t>(n));
+  }
+  EXPECT_NE(got.find("Content-Type: text/event-stream"), std::string::npos) << got;
+  std::size_t at = 0;
+  for (const char* id : {"id: 1\n", "id: 2\n", "id: 3\n", "id: 4\n"}) {
+    const std::size_t next = got.find(id, at);
+    ASSERT_NE(next, std::string::npos) << id << " missing or out of order in\n" << got;
+    EXPECT_EQ(got.compare(next - 13, 13, "event: state\n"), 0);
+    at = next;
+  }
+  EXPECT_NE(got.find("data: {\"cycle\":4,"), std::string::npos);
+  // A stream that ends frees its place.
+  close(streams[0]);
+  streams.erase(streams.begin());
+  bool admitted = false;
+  for (int i = 0; i < 40 && !admitted; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const int s = connect_to(port());
+    const std::string req = get("/api/stream");
+    send(s, req.data(), req.size(), MSG_NOSIGNAL);
+    const ssize_t n = recv(s, buf, sizeof(buf), 0);
+    admitted = n > 0 && status_of(std::string(buf, static_cast<size_t>(n))) == 200;
+    if (admitted) {
+      streams.push_back(s);
+    } else {
+      close(s);
+    }
+  }
+  EXPECT_TRUE(admitted) << "the closed stream's place was not freed within 4 s";
+  for (int s : streams) close(s);
+}
