@@ -76,6 +76,9 @@ if(TARGET tacse3_viewer_assets)
   install(DIRECTORY "${TACSE3_VIEWER_DIR}/" DESTINATION "${CMAKE_INSTALL_DATADIR}/tacse3/viewer"
           COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
   add_dependencies(tacse3_package_programs tacse3_viewer_assets)
+  # The drop-in that opens the unit to IPv4 for it, for the integrator to enable.
+  install(FILES "${_tacse3_pkg_src}/viewer-network.conf" DESTINATION "${CMAKE_INSTALL_DATADIR}/tacse3/systemd"
+          COMPONENT ${_tacse3_pkg_comp} EXCLUDE_FROM_ALL)
 endif()
 # The simulator's calibration: tacse3d --board sim and tacse3-replay of a simulator recording
 # use it when no --calibration is given (config::find_sim_calibration).

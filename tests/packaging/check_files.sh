@@ -23,11 +23,21 @@ case_unit() {
   mkdir -p "$TMP/unit"
   sed 's#^ExecStart=/usr/bin/tacse3d #ExecStart=/bin/true #' "$PKG/tacse3d.service" >"$TMP/unit/tacse3d.service"
   grep -q '^ExecStart=/bin/true ' "$TMP/unit/tacse3d.service" || fail "tacse3d.service: no ExecStart=/usr/bin/tacse3d line"
-  local out
+  local out want
   out=$(cd "$TMP/unit" && SYSTEMD_LOG_LEVEL=warning systemd-analyze verify ./tacse3d.service 2>&1) ||
     fail "systemd-analyze verify: $out"
   [ -z "$out" ] || fail "systemd-analyze verify reported: $out"
-  local want n=0
+  # The live view's drop-in (not enabled by the package) verifies with the unit.
+  mkdir -p "$TMP/unit/tacse3d.service.d"
+  cp "$PKG/viewer-network.conf" "$TMP/unit/tacse3d.service.d/"
+  out=$(cd "$TMP/unit" && SYSTEMD_LOG_LEVEL=warning systemd-analyze verify ./tacse3d.service 2>&1) ||
+    fail "systemd-analyze verify with viewer-network.conf: $out"
+  [ -z "$out" ] || fail "systemd-analyze verify with viewer-network.conf reported: $out"
+  for want in 'RestrictAddressFamilies=AF_INET' 'IPAddressAllow=localhost'; do
+    grep -qxF -- "$want" "$PKG/viewer-network.conf" || fail "viewer-network.conf lacks '$want'"
+  done
+  rm -r "$TMP/unit/tacse3d.service.d"
+  local n=0
   while IFS= read -r want; do
     grep -qxF -- "$want" "$PKG/tacse3d.service" || fail "tacse3d.service lacks the line '$want'"
     n=$((n + 1))

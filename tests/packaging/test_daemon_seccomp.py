@@ -4,7 +4,8 @@
 
 seccomp_exec applies the allow list that unit_syscalls.sh expands from the unit, with SIGSYS for
 anything else, then runs the sim board with a CAN log, a recording, sd_notify (READY=1, the
-watchdog) and a SIGHUP reload. The run must finish cleanly; the same run without mlockall on the
+watchdog), a SIGHUP reload and, when tacse3d is built with it, the live view (--http, one
+GET /api/state). The run must finish cleanly; the same run without mlockall on the
 list must be killed by SIGSYS, which shows the filter is in force.
 
 usage: test_daemon_seccomp.py SECCOMP_EXEC TACSE3D SOURCE_DIR
@@ -16,6 +17,27 @@ import subprocess
 import sys
 import tempfile
 import time
+import urllib.request
+
+
+def viewer_built(tacse3d):
+    """The build tree's tacse3d finds its page in <exe_dir>/../share/tacse3/viewer."""
+    return os.path.exists(os.path.join(os.path.dirname(os.path.abspath(tacse3d)), "..", "share",
+                                       "tacse3", "viewer", "index.html"))
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def get_state(port):
+    try:
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/api/state", timeout=5) as r:
+            return r.status
+    except OSError as e:
+        return str(e)
 
 
 def run_daemon(seccomp_exec, tacse3d, src, allow, tmp, tag):
@@ -28,6 +50,10 @@ def run_daemon(seccomp_exec, tacse3d, src, allow, tmp, tag):
            "--calibration", os.path.join(src, "packaging", "calibration.toml"),
            "--seconds", "3", "--can-log", os.path.join(tmp, f"can-{tag}.log"),
            "--record", os.path.join(tmp, f"rec-{tag}")]
+    port = free_port() if viewer_built(tacse3d) else None
+    if port is not None:
+        cmd += ["--http", f"127.0.0.1:{port}"]
+    http = None
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     messages = []
     hup_sent = False
@@ -40,11 +66,13 @@ def run_daemon(seccomp_exec, tacse3d, src, allow, tmp, tag):
         if not hup_sent and any("READY=1" in m for m in messages):
             proc.send_signal(signal.SIGHUP)
             hup_sent = True
+            if port is not None:
+                http = get_state(port)
     if proc.poll() is None:
         proc.kill()
     _, err = proc.communicate()
     sock.close()
-    return proc.returncode, "\n".join(messages), err.decode(errors="replace")
+    return proc.returncode, "\n".join(messages), err.decode(errors="replace"), http
 
 
 def main():
@@ -61,7 +89,7 @@ def main():
         with open(allow, "w") as f:
             f.write("\n".join(names) + "\n")
 
-        rc, notes, err = run_daemon(seccomp_exec, tacse3d, src, allow, tmp, "unit")
+        rc, notes, err, http = run_daemon(seccomp_exec, tacse3d, src, allow, tmp, "unit")
         if rc != 0:
             why = " (killed by SIGSYS: a call outside the unit's filter)" if rc == -signal.SIGSYS else ""
             print(f"FAIL: tacse3d under the unit's filter exited {rc}{why}\n{err}", file=sys.stderr)
@@ -73,6 +101,9 @@ def main():
         if "reload" not in err.lower():
             print(f"FAIL: SIGHUP reload not reported on stderr:\n{err}", file=sys.stderr)
             return 1
+        if viewer_built(tacse3d) and http not in (200, 503):
+            print(f"FAIL: GET /api/state under the filter: {http}\n{err}", file=sys.stderr)
+            return 1
         with open(os.path.join(tmp, "can-unit.log")) as f:
             frames = sum(1 for line in f if line.startswith("("))
         rec = os.listdir(os.path.join(tmp, "rec-unit"))
@@ -82,13 +113,14 @@ def main():
 
         with open(allow, "w") as f:
             f.write("\n".join(n for n in names if n != "mlockall") + "\n")
-        rc2, _, _ = run_daemon(seccomp_exec, tacse3d, src, allow, tmp, "nomlock")
+        rc2, _, _, _ = run_daemon(seccomp_exec, tacse3d, src, allow, tmp, "nomlock")
         if rc2 != -signal.SIGSYS:
             print(f"FAIL: without mlockall on the list the daemon exited {rc2}, not SIGSYS: "
                   "the filter is not in force", file=sys.stderr)
             return 1
     print(f"daemon under SystemCallFilter ({len(names)} calls): exit 0, READY/WATCHDOG/STOPPING, "
-          f"SIGHUP reload, {frames} CAN frames, recording {sorted(rec)}; without mlockall: SIGSYS")
+          f"SIGHUP reload, {frames} CAN frames, recording {sorted(rec)}, viewer {http}; "
+          "without mlockall: SIGSYS")
     return 0
 
 
