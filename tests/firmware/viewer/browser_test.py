@@ -3,8 +3,8 @@
 """tacse3d's live view in headless Chromium (Debian's chromium, chromium-driver, python3-selenium).
 
 Starts tacse3d --board BOARD --http 127.0.0.1:PORT, loads the page and checks that the stream is
-live, the plots move, both pad canvases show an image (not blank), the overlays draw, and the
-pose readout is the angle of the page's own last snapshot. Saves a screenshot to --screenshot.
+live, the plots move, both pad canvases show an image (not blank), the left pad reads OK, and
+the pose readout matches /api/state on the same cycle. Saves a screenshot to --screenshot.
 Exit 77 (ctest: skipped) with a message when Chromium, its driver or selenium is missing.
 """
 import argparse
@@ -129,13 +129,18 @@ def main():
         text = js("return document.querySelector('#pad-left .padstate').textContent")
         assert text.startswith("OK"), f"left pad state reads {text!r}"
 
-        # The pose readout is the angle of the page's last snapshot's quaternion.
-        # (One script: a new event may arrive between two calls.)
-        snap, shown = js("return [window.tacse3.last(), "
-                         "document.getElementById('angle').textContent]")
-        w = abs(snap["pose"]["q"][0])
-        angle = 2 * math.degrees(math.acos(min(1.0, w)))
-        assert abs(float(shown) - angle) < 0.02, f"angle shown {shown}, snapshot {angle:.3f}"
+        # The pose readout matches /api/state: wait for a moment when the page shows the cycle the
+        # API serves (both change every 50 ms), then compare the angle shown with the API's.
+        def same_cycle():
+            cycle, shown = js("return [window.tacse3.last().cycle, "
+                              "document.getElementById('angle').textContent]")
+            api = state()
+            return (shown, api) if api and api["cycle"] == cycle else None
+        shown, api = wait_for("the page and /api/state on one cycle", same_cycle, 10)
+        w = min(1.0, abs(api["pose"]["q"][0]))
+        angle = 2 * math.degrees(math.acos(w))
+        assert abs(float(shown) - angle) < 0.006, f"angle shown {shown}, /api/state {angle:.4f}"
+        print(f"cycle {api['cycle']}: angle shown {shown} deg, /api/state {angle:.4f} deg")
 
         browser.save_screenshot(args.screenshot)
         print(f"screenshot: {args.screenshot}")
