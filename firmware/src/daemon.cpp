@@ -12,6 +12,7 @@
 #include "tacse3/dsp/se3.hpp"
 #include "tacse3/firmware/system.hpp"
 #if TACSE3_HAVE_VIEWER
+#include "tacse3/firmware/view_json.hpp"
 #include "tacse3/firmware/view_server.hpp"
 #else
 namespace tacse3::firmware {
@@ -378,6 +379,13 @@ bool Daemon::start_viewer(std::string* error) {
              "/index.html is missing; reinstall the package or build tacse3_viewer_assets)";
     return false;
   }
+  ViewInfo info;
+  info.version = std::to_string(TACSE3_VERSION_MAJOR) + "." + std::to_string(TACSE3_VERSION_MINOR) +
+                 "." + std::to_string(TACSE3_VERSION_PATCH);
+  info.board = board_.name;
+  info.board_file = board_.origin;
+  info.calibration = calibration_.file.string();
+  vc.info_json = view_info_json(info);
   view_slot_ = std::make_unique<ViewSlot>();
   view_server_ = ViewServer::start(vc, *view_slot_, &e);
   if (!view_server_) {

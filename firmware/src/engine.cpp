@@ -572,6 +572,16 @@ void Engine::publish_view(std::int64_t now_ns) noexcept {
   v.dsp_us = have_result_ ? last_dsp_us_ : -1;
   v.latency_us = last_latency_us_;
   fill_view_pads(pipeline_, result_, state_, config_.configured, &v);
+  v.counters.cycles_sent = stats_.cycles_sent;
+  v.counters.can_send_failures = stats_.send_failures;
+  v.counters.can_tx_dropped = shared_.can_tx_dropped.load(std::memory_order_relaxed);
+  v.counters.commands = stats_.commands;
+  v.counters.rejected_commands = shared_.rejected_commands.load(std::memory_order_relaxed);
+  for (std::size_t s = 0; s < 2; ++s) {
+    v.pads[s].frames = shared_.sensors[s].frames.load(std::memory_order_relaxed);
+    v.pads[s].dropped =
+        shared_.sensors[s].camera_drops.load(std::memory_order_relaxed) + pairing_drops_[s];
+  }
   view_->publish();
   next_view_ns_ = now_ns + kViewPeriodNs;
 }

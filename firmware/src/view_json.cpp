@@ -57,6 +57,10 @@ void pad_state(std::string& s, const ViewPad& p) {
   num(s, p.contact_area_m2);
   s += ",\"tracked_fraction\":";
   num(s, p.tracked_fraction);
+  s += ",\"frames\":";
+  integer(s, static_cast<long long>(p.frames));
+  s += ",\"dropped\":";
+  integer(s, static_cast<long long>(p.dropped));
   s += '}';
 }
 
@@ -106,11 +110,53 @@ std::string view_state_json(const ViewSnapshot& v) {
   integer(s, v.dsp_us);
   s += ",\"latency_us\":";
   integer(s, v.latency_us);
-  s += ",\"sensors\":{\"left\":";
+  s += ",\"counters\":{\"cycles_sent\":";
+  integer(s, static_cast<long long>(v.counters.cycles_sent));
+  s += ",\"can_send_failures\":";
+  integer(s, static_cast<long long>(v.counters.can_send_failures));
+  s += ",\"can_tx_dropped\":";
+  integer(s, static_cast<long long>(v.counters.can_tx_dropped));
+  s += ",\"commands\":";
+  integer(s, static_cast<long long>(v.counters.commands));
+  s += ",\"rejected_commands\":";
+  integer(s, v.counters.rejected_commands);
+  s += "},\"sensors\":{\"left\":";
   pad_state(s, v.pads[0]);
   s += ",\"right\":";
   pad_state(s, v.pads[1]);
   s += "}}";
+  return s;
+}
+
+std::string json_quote(std::string_view text) {
+  std::string s(1, '"');
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      s += '\\';
+      s += c;
+    } else if (u < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof(buf), "\\u%04x", u);
+      s += buf;
+    } else {
+      s += c;
+    }
+  }
+  s += '"';
+  return s;
+}
+
+std::string view_info_json(const ViewInfo& info) {
+  std::string s = "{\"version\":";
+  s += json_quote(info.version);
+  s += ",\"board\":";
+  s += json_quote(info.board);
+  s += ",\"board_file\":";
+  s += json_quote(info.board_file);
+  s += ",\"calibration\":";
+  s += info.calibration.empty() ? std::string("null") : json_quote(info.calibration);
+  s += '}';
   return s;
 }
 

@@ -192,6 +192,9 @@ void ViewServer::Impl::routes() {
     const Asset* a = &assets.at(n.name);
     server.Get(pattern, [a](const Request&, Response& res) { res.set_content(a->body, a->mime); });
   }
+  server.Get("/api/info", [this](const Request&, Response& res) {
+    res.set_content(config.info_json, "application/json");
+  });
   server.Get("/api/state", [this, no_cycle](const Request&, Response& res) {
     const auto r = current();
     if (!r) return no_cycle(res);

@@ -90,18 +90,24 @@ function show(s) {
   $('angle').textContent = fmt(aa.angle, 2);
   $('axis').textContent = '(' + aa.axis.map((a) => fmt(a, 3)).join(', ') + ')';
   $('position').textContent = '(' + s.pose.p.map((a) => fmt(a * 1e3, 2)).join(', ') + ')';
+  const c = s.counters;
+  $('counters').textContent = `cycles sent ${c.cycles_sent}, CAN send failures ${c.can_send_failures}, ` +
+    `CAN tx dropped ${c.can_tx_dropped}, commands ${c.commands} (${c.rejected_commands} rejected)`;
   for (const p of PADS) {
     const d = s.sensors[p];
     const el = document.querySelector('#pad-' + p + ' .padstate');
     el.textContent = !d.configured ? 'not on this board'
       : `${d.health}  ${d.contact ? (d.slipping ? 'SLIP' : 'STICK') : 'no contact'}  ` +
-        `area ${fmt(d.contact_area_m2 * 1e6, 1)} mm²  tracked ${fmt(d.tracked_fraction * 100, 0)} %`;
+        `area ${fmt(d.contact_area_m2 * 1e6, 1)} mm²  tracked ${fmt(d.tracked_fraction * 100, 0)} %  ` +
+        `frames ${d.frames} (${d.dropped} dropped)`;
   }
   record(s);
 }
 
 // --- images and overlays ---
 const images = {};
+const shearScale = { left: 0, right: 0 };
+const SHEAR_SCALE_DECAY = 0.98;  // per drawing at 5 Hz: the scale halves in about 7 s
 let fields = null;
 function drawPad(p) {
   const canvas = document.querySelector('#pad-' + p + ' canvas');
@@ -143,9 +149,11 @@ function drawPad(p) {
     g.stroke();
   }
   if ($('show-shear').checked) {
-    // Every second grid point; arrows scaled so the largest spans two grid cells.
+    // Every second grid point; the largest shear of the last seconds spans two grid cells (a
+    // decaying maximum: after a release the gel's noise is not blown up to full length).
     let max = 0;
     for (let i = 0; i < f.shear_x.length; i++) max = Math.max(max, Math.hypot(f.shear_x[i], f.shear_y[i]));
+    max = shearScale[p] = Math.max(max, shearScale[p] * SHEAR_SCALE_DECAY);
     if (max > 0) {
       const k = 2 * cw / max;
       g.strokeStyle = '#ffeb3b';
@@ -195,7 +203,17 @@ function connect() {
   };
 }
 
+async function showInfo() {
+  try {
+    const r = await fetch('api/info');
+    const i = await r.json();
+    $('info').textContent = `board ${i.board} (${i.board_file}), calibration ` +
+      `${i.calibration === null ? 'built-in defaults' : i.calibration}, tacse3d ${i.version}`;
+  } catch (e) { /* shown as "-" */ }
+}
+
 setupPlots();
+showInfo();
 connect();
 refreshImages();
 setInterval(redrawPlots, 100);

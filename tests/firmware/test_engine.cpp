@@ -470,4 +470,6 @@ TEST_F(EngineTest, ViewSnapshotCarriesTheLastCycle) {
   EXPECT_DOUBLE_EQ(view_->front().q[0], r.pose.q.w());
   EXPECT_DOUBLE_EQ(view_->front().w[2], r.twist[2]);
   EXPECT_DOUBLE_EQ(view_->front().p[2], r.pose.p.z());
+  EXPECT_EQ(view_->front().counters.cycles_sent, engine_->stats().cycles_sent);
+  EXPECT_GT(view_->front().counters.cycles_sent, 30u);
 }

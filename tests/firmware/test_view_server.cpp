@@ -96,11 +96,14 @@ void fill(ViewSnapshot* v, std::uint64_t cycle) {
   v->confidence = 0.75;
   v->dsp_us = 900;
   v->latency_us = 4100;
+  v->counters = {40, 1, 2, 3, 4};
   ViewPad& l = v->pads[0];
   l.configured = l.present = l.contact = true;
   l.health = static_cast<std::uint8_t>(protocol::SensorHealth::kOk);
   l.contact_area_m2 = 5e-5;
   l.tracked_fraction = 0.5;
+  l.frames = 100;
+  l.dropped = 5;
   for (std::size_t i = 0; i < l.luma.size(); ++i) l.luma[i] = static_cast<std::uint8_t>(i * 7);
   v->pads[1].health = static_cast<std::uint8_t>(protocol::SensorHealth::kNotAvailable);
 }
@@ -115,6 +118,7 @@ class ViewServerTest : public ::testing::Test {
     std::ofstream(assets_ / "viewer.css") << "css";
     config_.listen = {"127.0.0.1", free_port()};
     config_.assets = assets_;
+    config_.info_json = view_info_json({"0.1.0", "sim", "board.toml", ""});
     std::string e;
     server_ = ViewServer::start(config_, slot_, &e);
     ASSERT_TRUE(server_) << e;
@@ -152,17 +156,32 @@ TEST(ViewJson, StateIsTheDocumentedDocument) {
             "\"single_sensor\":false,\"calibrated\":true,"
             "\"twist\":{\"w\":[0.5,-0.25,0],\"v\":[0.001,null,0]},"
             "\"pose\":{\"q\":[0.5,0.5,0.5,0.5],\"p\":[0.01,0,-0.002]},\"confidence\":0.75,"
-            "\"dsp_us\":900,\"latency_us\":4100,\"sensors\":{"
+            "\"dsp_us\":900,\"latency_us\":4100,\"counters\":{\"cycles_sent\":40,"
+            "\"can_send_failures\":1,\"can_tx_dropped\":2,\"commands\":3,\"rejected_commands\":4},"
+            "\"sensors\":{"
             "\"left\":{\"configured\":true,\"present\":true,\"health\":\"OK\",\"contact\":true,"
-            "\"slipping\":false,\"contact_area_m2\":5e-05,\"tracked_fraction\":0.5},"
+            "\"slipping\":false,\"contact_area_m2\":5e-05,\"tracked_fraction\":0.5,\"frames\":100,"
+            "\"dropped\":5},"
             "\"right\":{\"configured\":false,\"present\":false,\"health\":\"NOT_AVAILABLE\","
-            "\"contact\":false,\"slipping\":false,\"contact_area_m2\":0,\"tracked_fraction\":0}}}");
+            "\"contact\":false,\"slipping\":false,\"contact_area_m2\":0,\"tracked_fraction\":0,"
+            "\"frames\":0,\"dropped\":0}}}");
   const std::string f = view_fields_json(v);
   EXPECT_EQ(f.rfind("{\"cycle\":42,\"grid\":{\"width\":40,\"height\":30,\"image_width\":160,"
                     "\"image_height\":120},\"left\":{\"mask\":[0,0,",
                     0),
             0u)
       << f.substr(0, 200);
+}
+
+TEST(ViewJson, InfoQuotesEveryString) {
+  EXPECT_EQ(json_quote("a\"b\\c\n\x01\xc3\xa9"), "\"a\\\"b\\\\c\\u000a\\u0001\xc3\xa9\"");
+  ViewInfo info{"0.1.0", "sim", "/etc/tacse3/boards/sim \"x\"/board.toml", ""};
+  EXPECT_EQ(view_info_json(info),
+            "{\"version\":\"0.1.0\",\"board\":\"sim\","
+            "\"board_file\":\"/etc/tacse3/boards/sim \\\"x\\\"/board.toml\",\"calibration\":null}");
+  info.calibration = "/etc/tacse3/calibration.toml";
+  EXPECT_NE(view_info_json(info).find("\"calibration\":\"/etc/tacse3/calibration.toml\"}"),
+            std::string::npos);
 }
 
 TEST_F(ViewServerTest, NothingButTheDocumentedEndpoints) {
@@ -180,6 +199,7 @@ TEST_F(ViewServerTest, NothingButTheDocumentedEndpoints) {
       {get("/api/state"), 200},
       {get("/api/state?x=1"), 200},
       {get("/api/fields"), 200},
+      {get("/api/info"), 200},
       {get("/api/image/left.jpg"), 200},
       {get("/api/image/right.jpg"), 404},  // not configured in the snapshot
       {get("/api/image/centre.jpg"), 404},
@@ -206,6 +226,7 @@ TEST_F(ViewServerTest, NothingButTheDocumentedEndpoints) {
   const std::string page = exchange(port(), get("/"));
   EXPECT_EQ(body_of(page), "<p>page</p>");
   EXPECT_NE(page.find("Content-Type: text/html"), std::string::npos);
+  EXPECT_EQ(body_of(exchange(port(), get("/api/info"))), config_.info_json);
   // Still serving after all that.
   EXPECT_EQ(status_of(exchange(port(), get("/api/state"))), 200);
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 #include "tacse3/firmware/view_snapshot.hpp"
 
@@ -10,6 +11,16 @@ namespace tacse3::firmware {
 
 // GET /api/state and each /api/stream event: the cycle's scalars, one line, no spaces.
 std::string view_state_json(const ViewSnapshot& v);
+// GET /api/info: what does not change while the daemon runs.
+struct ViewInfo {
+  std::string version;      // tacse3d's
+  std::string board;        // the board's name
+  std::string board_file;   // the file it came from
+  std::string calibration;  // the calibration file, empty: the built-in defaults
+};
+std::string view_info_json(const ViewInfo& info);
+// A JSON string literal of `text`: quotes, backslashes and control characters escaped.
+std::string json_quote(std::string_view text);
 // GET /api/fields: the per-pad grid fields (contact mask, shear, f^z), row-major.
 std::string view_fields_json(const ViewSnapshot& v);
 

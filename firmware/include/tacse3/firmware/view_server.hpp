@@ -16,6 +16,7 @@ namespace tacse3::firmware {
 struct ViewServerConfig {
   config::ListenAddress listen;
   std::filesystem::path assets;  // folder holding index.html, viewer.js, viewer.css, uPlot
+  std::string info_json = "{}";  // GET /api/info (view_info_json)
   int threads = 8;               // connections served at once
   int max_streams = 4;           // /api/stream clients at once; more get 503
   int write_timeout_ms = 2000;   // a client that takes no data this long is dropped

@@ -24,11 +24,22 @@ struct ViewPad {
   std::uint8_t health = 0;        // protocol::SensorHealth
   double contact_area_m2 = 0.0;   // |Ω| times the area of one grid cell
   double tracked_fraction = 0.0;  // valid block-flow points / grid points
+  std::uint64_t frames = 0;       // frames the capture thread handed over
+  std::uint64_t dropped = 0;      // frames lost: camera sequence gaps, full ring, late for pairing
   std::array<std::uint8_t, dsp::kWorkPixels> luma{};  // working image, 8-bit (160 x 120)
   std::array<std::uint8_t, dsp::kGridCount> mask{};   // Ω, 0/1, row-major 40 x 30
   std::array<float, dsp::kGridCount> shear_x{};       // calibrated shear, shear units
   std::array<float, dsp::kGridCount> shear_y{};
   std::array<float, dsp::kGridCount> fz{};  // normal response f^z, f^z units
+};
+
+// The engine's counters since the start (the CAN Status carries them modulo 2^16).
+struct ViewCounters {
+  std::uint64_t cycles_sent = 0;
+  std::uint64_t can_send_failures = 0;  // Channel::send refused a frame
+  std::uint64_t can_tx_dropped = 0;     // the channel's own count of dropped frames
+  std::uint64_t commands = 0;           // commands answered
+  std::uint32_t rejected_commands = 0;  // commands refused by validation
 };
 
 struct ViewSnapshot {
@@ -46,6 +57,7 @@ struct ViewSnapshot {
   double confidence = 0.0;
   std::int64_t dsp_us = -1;      // pipeline time of the last cycle
   std::int64_t latency_us = -1;  // frame timestamp -> cycle sent, last cycle (-1: none)
+  ViewCounters counters{};
   std::array<ViewPad, 2> pads{};
 };
 
