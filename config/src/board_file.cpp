@@ -512,11 +512,13 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
   }
 
   if (const toml::table* t = rd.table(root, "viewer", "")) {
-    rd.only_keys(*t, "viewer", {"listen"});
+    rd.only_keys(*t, "viewer", {"listen", "controls"});
     rd.string(*t, "listen", "viewer", &b.viewer.listen);
+    rd.boolean(*t, "controls", "viewer", &b.viewer.controls);
     ListenAddress a;
     std::string e;
-    if (rd.ok() && !parse_listen_address(b.viewer.listen, &a, &e)) {
+    // controls alone is fine: --http gives the address.
+    if (rd.ok() && t->get("listen") != nullptr && !parse_listen_address(b.viewer.listen, &a, &e)) {
       rd.fail(t->get("listen"), "key \"viewer.listen\": " + e);
     }
   }
@@ -661,7 +663,7 @@ std::string describe(const BoardConfig& b) {
   s << "  viewer: "
     << (b.viewer.listen.empty() ? std::string("off")
                                 : std::string("http on ").append(b.viewer.listen))
-    << "\n";
+    << (b.viewer.controls ? ", controls on" : "") << "\n";
   return s.str();
 }
 

@@ -364,6 +364,28 @@ TEST(Board, ViewerListenIsOffByDefaultAndChecked) {
   EXPECT_NE(addr.find("the address must be an IPv4 address"), std::string::npos) << addr;
 }
 
+TEST(Board, ViewerControlsAreOffByDefault) {
+  BoardConfig b;
+  std::string e;
+  ASSERT_TRUE(
+      parse_board(std::string(kMinimal) + "[viewer]\nlisten = \"8080\"\n", "test.toml", &b, &e))
+      << e;
+  EXPECT_FALSE(b.viewer.controls);
+  ASSERT_TRUE(parse_board(std::string(kMinimal) + "[viewer]\nlisten = \"8080\"\ncontrols = true\n",
+                          "test.toml", &b, &e))
+      << e;
+  EXPECT_TRUE(b.viewer.controls);
+  EXPECT_NE(describe(b).find("http on 8080, controls on"), std::string::npos) << describe(b);
+  ASSERT_TRUE(
+      parse_board(std::string(kMinimal) + "[viewer]\ncontrols = true\n", "test.toml", &b, &e))
+      << "controls without listen: --http gives the address; " << e;
+  EXPECT_EQ(b.viewer.listen, "");
+  EXPECT_TRUE(b.viewer.controls);
+  EXPECT_NE(describe(b).find("viewer: off, controls on"), std::string::npos) << describe(b);
+  const std::string type = error_of(std::string(kMinimal) + "[viewer]\ncontrols = \"yes\"\n");
+  EXPECT_NE(type.find("viewer.controls"), std::string::npos) << type;
+}
+
 TEST(ListenAddress, PortAloneBindsToLocalhost) {
   struct Case {
     const char* text;

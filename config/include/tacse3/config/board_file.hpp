@@ -118,7 +118,8 @@ struct RecordBoardConfig {
 
 // [viewer]: the live web view (docs/viewer.md). Empty listen: off.
 struct ViewerBoardConfig {
-  std::string listen;  // "PORT" or "ADDR:PORT", checked by parse_listen_address
+  std::string listen;     // "PORT" or "ADDR:PORT", checked by parse_listen_address
+  bool controls = false;  // POST /api/command (tare, reset pose, stream on/off) allowed
 };
 
 struct BoardConfig {
