@@ -385,6 +385,19 @@ bool Daemon::start_viewer(std::string* error) {
   info.board = board_.name;
   info.board_file = board_.origin;
   info.calibration = calibration_.file.string();
+  if (!board_.viewer.controls) {
+    info.controls_off = board_.origin +
+                        ": [viewer] controls is not true (set controls = true there to enable "
+                        "tare, reset pose and stream on/off)";
+  } else {
+    web_commands_ = std::make_unique<CommandMailbox>();
+    vc.commands = web_commands_.get();
+    engine_->set_web_commands(web_commands_.get());
+  }
+  vc.controls_off = info.controls_off;
+  vc.endpoint.node_id = static_cast<std::uint8_t>(board_.can.node_id);
+  vc.endpoint.layout.mode =
+      board_.can.extended_ids ? protocol::IdMode::kExtended : protocol::IdMode::kStandard;
   vc.info_json = view_info_json(info);
   view_slot_ = std::make_unique<ViewSlot>();
   view_server_ = ViewServer::start(vc, *view_slot_, &e);
@@ -398,8 +411,8 @@ bool Daemon::start_viewer(std::string* error) {
   return true;
 #else
   *error = what +
-           ": this tacse3d was built without the live viewer (libcpp-httplib-dev or "
-           "libturbojpeg0-dev missing for this target)";
+           ": this tacse3d was built without the live viewer (libcpp-httplib-dev, "
+           "libturbojpeg0-dev or nlohmann-json3-dev missing for this target)";
   return false;
 #endif
 }

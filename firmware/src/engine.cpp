@@ -265,7 +265,37 @@ void Engine::handle_command(const protocol::CommandResult& r) noexcept {
                          r.command.code == protocol::CommandCode::kStopRecording;
   if (r.code == protocol::AckCode::kAck && recording) {
     if (!recording_command(r.command, ack)) return;  // answered by finish_recording_start()
-  } else if (r.code == protocol::AckCode::kAck) {
+  } else {
+    ack = answer(r);
+  }
+  protocol::CanFrame f;
+  if (protocol::encode(ack, config_.tx, f) == protocol::Status::kOk) send(f);
+  ++stats_.commands;
+}
+
+// The viewer's controls: the same validation (done by the web side with validate_command) and
+// the same application as a CAN command; the answer goes back to the mailbox. Recording is
+// started and stopped over CAN or with the button only: its answer may be deferred.
+bool Engine::handle_web_command() noexcept {
+  protocol::CommandResult r;
+  if (web_commands_ == nullptr || !web_commands_->take(&r)) return false;
+  const bool recording = r.command.code == protocol::CommandCode::kStartRecording ||
+                         r.command.code == protocol::CommandCode::kStopRecording;
+  protocol::Ack ack = protocol::make_ack(r);
+  if (recording && r.code == protocol::AckCode::kAck) {
+    ack.result = protocol::AckCode::kBusy;
+  } else {
+    ack = answer(r);
+  }
+  web_commands_->answer(ack);
+  ++stats_.commands;
+  return true;
+}
+
+// Applies a validated, non-recording command (all or nothing) and builds its ACK/NACK.
+protocol::Ack Engine::answer(const protocol::CommandResult& r) noexcept {
+  protocol::Ack ack = protocol::make_ack(r);
+  if (r.code == protocol::AckCode::kAck) {
     if (!apply(r.command)) {
       ack.result = protocol::AckCode::kInternalError;
     } else if (r.command.code == protocol::CommandCode::kQuery) {
@@ -292,9 +322,7 @@ void Engine::handle_command(const protocol::CommandResult& r) noexcept {
       ack = protocol::make_query_reply(r.command, q);
     }
   }
-  protocol::CanFrame f;
-  if (protocol::encode(ack, config_.tx, f) == protocol::Status::kOk) send(f);
-  ++stats_.commands;
+  return ack;
 }
 
 void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcept {
@@ -474,6 +502,7 @@ bool Engine::step(std::int64_t now_ns) noexcept {
       worked = true;
     }
   }
+  if (handle_web_command()) worked = true;
   const std::uint32_t taps = shared_.tare_requests.load(std::memory_order_acquire);
   if (taps != tare_seen_) {
     tare_seen_ = taps;

@@ -156,6 +156,10 @@ std::string view_info_json(const ViewInfo& info) {
   s += json_quote(info.board_file);
   s += ",\"calibration\":";
   s += info.calibration.empty() ? std::string("null") : json_quote(info.calibration);
+  s += ",\"controls\":";
+  s += info.controls_off.empty() ? "true" : "false";
+  s += ",\"controls_off\":";
+  s += info.controls_off.empty() ? std::string("null") : json_quote(info.controls_off);
   s += '}';
   return s;
 }

@@ -17,10 +17,12 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
 #include "tacse3/firmware/view_json.hpp"
+#include "tacse3/protocol/commands.hpp"
 
 namespace tacse3::firmware {
 
@@ -79,12 +81,77 @@ std::string encode_jpeg(tjhandle tj, const std::array<std::uint8_t, dsp::kWorkPi
   return out;
 }
 
+std::string error_json(const std::string& message) {
+  std::string s = "{\"error\":";
+  s += json_quote(message);
+  s += "}\n";
+  return s;
+}
+
+// The ACK/NACK as the HTTP answer: the same codes as the CAN Ack frame (docs/can-protocol.md).
+std::string ack_json(const protocol::Ack& a) {
+  std::string s = "{\"command\":";
+  s += json_quote(protocol::to_string(a.command));
+  s += ",\"ack\":";
+  s += a.result == protocol::AckCode::kAck ? "true" : "false";
+  s += ",\"code\":";
+  s += std::to_string(static_cast<int>(a.result));
+  s += ",\"result\":";
+  s += json_quote(protocol::to_string(a.result));
+  s += ",\"sequence\":";
+  s += std::to_string(static_cast<int>(a.sequence));
+  s += "}\n";
+  return s;
+}
+
 // Linux: nice is per thread, and threads inherit it from the thread that creates them.
 void lower_priority(int nice) {
   setpriority(PRIO_PROCESS, 0, nice);
 }
 
 }  // namespace
+
+bool parse_web_command(const std::string& body, protocol::Command* command, std::string* error) {
+  const nlohmann::json j = nlohmann::json::parse(body, nullptr, false);
+  const char* forms =
+      "expected {\"command\": \"tare\"}, {\"command\": \"reset_pose\"} or "
+      "{\"command\": \"stream\", \"on\": true|false}";
+  if (j.is_discarded() || !j.is_object()) {
+    *error = std::string("the body is not a JSON object: ") + forms;
+    return false;
+  }
+  const auto name = j.find("command");
+  if (name == j.end() || !name->is_string()) {
+    *error = std::string("\"command\" is missing or not a string: ") + forms;
+    return false;
+  }
+  const std::string n = name->get<std::string>();
+  protocol::Command c;
+  std::size_t keys = 1;
+  if (n == "tare") {
+    c.code = protocol::CommandCode::kTare;
+  } else if (n == "reset_pose") {
+    c.code = protocol::CommandCode::kResetPose;
+  } else if (n == "stream") {
+    const auto on = j.find("on");
+    if (on == j.end() || !on->is_boolean()) {
+      *error = "\"stream\" needs \"on\": true or false";
+      return false;
+    }
+    c.code = protocol::CommandCode::kSetStream;
+    c.stream_enabled = on->get<bool>();
+    keys = 2;
+  } else {
+    *error = std::string("unknown command \"").append(n).append("\": ").append(forms);
+    return false;
+  }
+  if (j.size() != keys) {
+    *error = std::string("unknown key in the body: ").append(forms);
+    return false;
+  }
+  *command = c;
+  return true;
+}
 
 struct ViewServer::Impl {
   Impl(const ViewServerConfig& c, ViewSlot& s) : config(c), slot(s) {}
@@ -168,8 +235,54 @@ struct ViewServer::Impl {
     return true;
   }
 
+  // One command at a time: the mailbox holds one, and its answer belongs to this request.
+  std::mutex command_mutex;
+  std::uint8_t command_sequence = 0;  // guarded by command_mutex
+
+  void command(const httplib::Request& req, httplib::Response& res);
   void routes();
 };
+
+// POST /api/command: built as this node's CAN Command frame and validated by validate_command,
+// exactly as the RX thread does, then applied by the DSP thread between two cycles.
+void ViewServer::Impl::command(const httplib::Request& req, httplib::Response& res) {
+  const auto fail = [&res](int status, const std::string& message) {
+    res.status = status;
+    res.set_content(error_json(message), "application/json");
+  };
+  if (config.commands == nullptr) return fail(403, config.controls_off);
+  // A JSON content type makes a browser ask first (CORS preflight) before another site's page
+  // can post here; the server never allows it.
+  if (req.get_header_value("Content-Type").rfind("application/json", 0) != 0)
+    return fail(415, "the body must be JSON: send Content-Type: application/json");
+  protocol::Command c;
+  std::string e;
+  if (!parse_web_command(req.body, &c, &e)) return fail(400, e);
+  std::lock_guard<std::mutex> lock(command_mutex);
+  c.sequence = command_sequence;
+  command_sequence = static_cast<std::uint8_t>((command_sequence + 1) & 0x0Fu);
+  protocol::TxConfig tx;
+  tx.endpoint = config.endpoint;
+  protocol::CanFrame f;
+  if (protocol::encode(c, tx, f) != protocol::Status::kOk)
+    return fail(500, "the command could not be encoded");
+  const protocol::CommandResult r = protocol::validate_command(f, config.endpoint);
+  if (!r.addressed) return fail(500, "the command is not addressed to this node");
+  if (!config.commands->submit(r))
+    return fail(503, "the previous command is still waiting for the DSP thread; try again");
+  protocol::Ack ack;
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(config.command_timeout_ms);
+  while (!config.commands->poll(&ack)) {
+    if (std::chrono::steady_clock::now() > deadline)
+      return fail(504, std::string("the DSP thread did not answer within ")
+                           .append(std::to_string(config.command_timeout_ms))
+                           .append(" ms"));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  res.status = ack.result == protocol::AckCode::kAck ? 200 : 409;
+  res.set_content(ack_json(ack), "application/json");
+}
 
 void ViewServer::Impl::routes() {
   using httplib::Request;
@@ -221,6 +334,7 @@ void ViewServer::Impl::routes() {
                res.set_header("X-Cycle", std::to_string(r->snapshot->cycle));
                res.set_content(r->jpeg[s], "image/jpeg");
              });
+  server.Post("/api/command", [this](const Request& req, Response& res) { command(req, res); });
   server.Get("/api/stream", [this](const Request&, Response& res) {
     if (streams.fetch_add(1) >= config.max_streams) {
       streams.fetch_sub(1);
@@ -274,7 +388,7 @@ std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, Vi
   sv.set_keep_alive_timeout(2);
   sv.set_read_timeout(2, 0);
   sv.set_write_timeout(config.write_timeout_ms / 1000, (config.write_timeout_ms % 1000) * 1000);
-  sv.set_payload_max_length(4096);  // GET only: no request body is ever needed
+  sv.set_payload_max_length(4096);  // the largest body is POST /api/command's few bytes
   impl->routes();
   errno = 0;
   if (!sv.bind_to_port(config.listen.host, config.listen.port)) {

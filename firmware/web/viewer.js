@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // tacse3d live view: reads /api/stream (Server-Sent Events), /api/fields and the pads' JPEGs
-// (docs/viewer.md) and draws them. Read-only: it sends nothing but GET requests.
+// (docs/viewer.md) and draws them. Its only write is POST /api/command, from the control
+// buttons, which are greyed out unless the board enables the controls.
 'use strict';
 
 const WINDOW_S = 10;       // rolling plots
@@ -209,7 +210,52 @@ async function showInfo() {
     const i = await r.json();
     $('info').textContent = `board ${i.board} (${i.board_file}), calibration ` +
       `${i.calibration === null ? 'built-in defaults' : i.calibration}, tacse3d ${i.version}`;
+    setupControls(i);
   } catch (e) { /* shown as "-" */ }
+}
+
+// --- controls: each button posts one command; the daemon's ACK/NACK is shown as it came ---
+const COMMANDS = {
+  'cmd-tare': { command: 'tare' },
+  'cmd-reset-pose': { command: 'reset_pose' },
+  'cmd-stream-on': { command: 'stream', on: true },
+  'cmd-stream-off': { command: 'stream', on: false },
+};
+
+function setupControls(info) {
+  if (!info.controls) {
+    $('controls-off').textContent = 'Controls disabled: ' + info.controls_off;
+    $('controls-off').hidden = false;
+    return;
+  }
+  for (const [id, body] of Object.entries(COMMANDS)) {
+    $(id).disabled = false;
+    $(id).addEventListener('click', () => send(body));
+  }
+}
+
+async function send(body) {
+  const ack = $('ack');
+  ack.textContent = `${body.command}: sent`;
+  ack.className = '';
+  try {
+    const r = await fetch('api/command', {
+      method: 'POST', headers: { 'Content-Type': 'application/json' },
+      body: JSON.stringify(body),
+    });
+    const a = await r.json();
+    if (a.result !== undefined) {
+      ack.textContent = `${a.command}: ${a.ack ? 'ACK' : 'NACK ' + a.result} (code ${a.code}, ` +
+        `sequence ${a.sequence})`;
+      ack.className = a.ack ? 'ack-ok' : 'ack-bad';
+    } else {
+      ack.textContent = `${body.command}: HTTP ${r.status}: ${a.error}`;
+      ack.className = 'ack-bad';
+    }
+  } catch (e) {
+    ack.textContent = `${body.command}: no answer (${e})`;
+    ack.className = 'ack-bad';
+  }
 }
 
 setupPlots();

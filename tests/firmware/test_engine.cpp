@@ -320,6 +320,65 @@ TEST_F(EngineTest, TareFromCommandOrButtonRestartsThePoseAndFlagsTheCycle) {
   }
 }
 
+// The viewer's controls: the web side validates the command as this node's CAN frame (as
+// ViewServer does) and the engine applies it like the CAN tare above; the ACK comes back to the
+// mailbox, not on the bus (no CAN controller asked).
+TEST_F(EngineTest, TareFromTheViewerIsTheCanTareAnsweredToTheMailbox) {
+  CommandMailbox box;
+  engine_->set_web_commands(&box);
+  const auto web = [&](const protocol::Command& c) {
+    protocol::TxConfig tx;
+    protocol::CanFrame f;
+    EXPECT_EQ(protocol::encode(c, tx, f), protocol::Status::kOk);
+    EXPECT_TRUE(box.submit(protocol::validate_command(f, tx.endpoint)));
+  };
+  for (std::size_t i = 0; i < 40; ++i) tick(i);
+  protocol::Command tare;
+  tare.code = protocol::CommandCode::kTare;
+  tare.sequence = 5;
+  web(tare);
+  protocol::Ack ack;
+  EXPECT_FALSE(box.poll(&ack)) << "answered only by the DSP thread's step";
+  tick(40);
+  ASSERT_TRUE(box.poll(&ack));
+  EXPECT_EQ(ack.command, protocol::CommandCode::kTare);
+  EXPECT_EQ(ack.result, protocol::AckCode::kAck);
+  EXPECT_EQ(ack.sequence, 5);
+  for (std::size_t i = 41; i < 50; ++i) tick(i);
+
+  protocol::Command stop;
+  stop.code = protocol::CommandCode::kSetStream;
+  stop.stream_enabled = false;
+  web(stop);
+  tick(50);
+  ASSERT_TRUE(box.poll(&ack));
+  EXPECT_EQ(ack.command, protocol::CommandCode::kSetStream);
+  EXPECT_EQ(ack.result, protocol::AckCode::kAck);
+  EXPECT_EQ(ack.data[0], 0) << "the argument is echoed";
+  EXPECT_FALSE(engine_->stream_enabled());
+  for (std::size_t i = 51; i < 60; ++i) tick(i);
+
+  protocol::Command record;  // not a web command: refused, never half started
+  record.code = protocol::CommandCode::kStartRecording;
+  web(record);
+  tick(60);
+  ASSERT_TRUE(box.poll(&ack));
+  EXPECT_EQ(ack.result, protocol::AckCode::kBusy);
+  EXPECT_EQ(engine_->stats().commands, 3u);
+
+  const auto b = decode();
+  EXPECT_TRUE(b.acks.empty()) << "web answers stay off the bus";
+  ASSERT_EQ(b.cycles.size(), 50u) << "the stream stopped after cycle 50";
+  std::vector<std::size_t> flagged;
+  for (std::size_t i = 0; i < b.cycles.size(); ++i) {
+    if (b.cycles[i].pose_reset) flagged.push_back(i);
+  }
+  ASSERT_EQ(flagged.size(), 1u);
+  EXPECT_EQ(flagged[0], 40u);
+  EXPECT_NEAR(b.cycles[40].orientation.w, 1.0, 1e-3);
+  EXPECT_NEAR(b.cycles[40].position.x, 0.0, 1e-4);
+}
+
 TEST_F(EngineTest, BothSensorsLostIsAFault) {
   for (std::size_t i = 0; i < 20; ++i) tick(i);
   shared_.sensors[0].disconnected.store(true);
@@ -412,9 +471,13 @@ TEST_F(EngineTest, LoopDoesNotAllocate) {
   shared_.calibration = {pipeline_->sensor(dsp::SensorSlot::kLeft).calibration(),
                          pipeline_->sensor(dsp::SensorSlot::kRight).calibration()};
   engine_->set_view(view_.get());  // the live viewer's publication is on
+  CommandMailbox web;              // and its controls
+  engine_->set_web_commands(&web);
+  protocol::Ack web_ack;
   test::reset_allocation_count();
   for (std::size_t i = 30; i < 150; ++i) {
     if (i % 20 == 0) commands_[0].push(pending[(i / 20) % pending.size()]);
+    if (i == 70) web.submit(pending[0]);
     if (i == 100) shared_.calibration_flag.store(SharedState::kPending);
     if (i == 120) shared_.sensors[1].disconnected.store(true);
     tick(i, true, i < 120);
@@ -422,7 +485,9 @@ TEST_F(EngineTest, LoopDoesNotAllocate) {
   const std::uint64_t allocations = test::allocation_count();
   EXPECT_EQ(allocations, 0u);
   EXPECT_EQ(shared_.calibration_flag.load(), SharedState::kApplied);
-  EXPECT_EQ(engine_->stats().commands, 6u);
+  EXPECT_TRUE(web.poll(&web_ack));
+  EXPECT_EQ(web_ack.result, protocol::AckCode::kAck);
+  EXPECT_EQ(engine_->stats().commands, 7u);
   EXPECT_EQ(engine_->state().state, protocol::State::kDegradedSingleSensor);
   // At most one publication per 50 ms: on the 120 Hz ticks, the 7th after the last (6 periods
   // are 49.99998 ms), so 120 ticks publish 17 or 18 times.

@@ -8,17 +8,20 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "tacse3/firmware/view_json.hpp"
 #include "tacse3/firmware/view_server.hpp"
+#include "tacse3/protocol/commands.hpp"
 #include "tacse3/protocol/types.hpp"
 
 namespace fs = std::filesystem;
@@ -118,7 +121,7 @@ class ViewServerTest : public ::testing::Test {
     std::ofstream(assets_ / "viewer.css") << "css";
     config_.listen = {"127.0.0.1", free_port()};
     config_.assets = assets_;
-    config_.info_json = view_info_json({"0.1.0", "sim", "board.toml", ""});
+    config_.info_json = view_info_json({"0.1.0", "sim", "board.toml", "", ""});
     std::string e;
     server_ = ViewServer::start(config_, slot_, &e);
     ASSERT_TRUE(server_) << e;
@@ -144,6 +147,62 @@ class ViewServerTest : public ::testing::Test {
   ViewServerConfig config_;
   ViewSlot slot_;
   std::unique_ptr<ViewServer> server_;
+};
+
+std::string post(const std::string& path, const std::string& body,
+                 const std::string& type = "application/json") {
+  return "POST " + path + " HTTP/1.1\r\nHost: t\r\nContent-Type: " + type +
+         "\r\nContent-Length: " + std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" +
+         body;
+}
+
+// The server with its controls on; a thread plays the DSP thread's part of the mailbox: it keeps
+// what it was given and answers with make_ack (the engine's answer before applying), or with
+// `nack`, or not at all while `silent`.
+class ViewControlsTest : public ViewServerTest {
+ protected:
+  void SetUp() override {
+    ViewServerTest::SetUp();
+    server_.reset();
+    config_.commands = &box_;
+    config_.endpoint.node_id = 5;
+    config_.command_timeout_ms = 300;
+    dsp_ = std::thread([this] {
+      while (!stop_) {
+        protocol::CommandResult r;
+        if (!silent_ && box_.take(&r)) {
+          protocol::Ack a = protocol::make_ack(r);
+          if (nack_ != 0) a.result = static_cast<protocol::AckCode>(nack_.load());
+          {
+            std::lock_guard<std::mutex> lock(mutex_);
+            taken_.push_back(r);
+          }
+          box_.answer(a);
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    });
+    std::string e;
+    server_ = ViewServer::start(config_, slot_, &e);
+    ASSERT_TRUE(server_) << e;
+  }
+  void TearDown() override {
+    stop_ = true;
+    dsp_.join();
+    ViewServerTest::TearDown();
+  }
+  std::vector<protocol::CommandResult> taken() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return taken_;
+  }
+
+  CommandMailbox box_;
+  std::thread dsp_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> silent_{false};
+  std::atomic<int> nack_{0};
+  std::mutex mutex_;
+  std::vector<protocol::CommandResult> taken_;
 };
 
 }  // namespace
@@ -175,13 +234,19 @@ TEST(ViewJson, StateIsTheDocumentedDocument) {
 
 TEST(ViewJson, InfoQuotesEveryString) {
   EXPECT_EQ(json_quote("a\"b\\c\n\x01\xc3\xa9"), "\"a\\\"b\\\\c\\u000a\\u0001\xc3\xa9\"");
-  ViewInfo info{"0.1.0", "sim", "/etc/tacse3/boards/sim \"x\"/board.toml", ""};
+  ViewInfo info{"0.1.0", "sim", "/etc/tacse3/boards/sim \"x\"/board.toml", "", ""};
   EXPECT_EQ(view_info_json(info),
             "{\"version\":\"0.1.0\",\"board\":\"sim\","
-            "\"board_file\":\"/etc/tacse3/boards/sim \\\"x\\\"/board.toml\",\"calibration\":null}");
+            "\"board_file\":\"/etc/tacse3/boards/sim \\\"x\\\"/board.toml\",\"calibration\":null,"
+            "\"controls\":true,\"controls_off\":null}");
   info.calibration = "/etc/tacse3/calibration.toml";
-  EXPECT_NE(view_info_json(info).find("\"calibration\":\"/etc/tacse3/calibration.toml\"}"),
+  EXPECT_NE(view_info_json(info).find("\"calibration\":\"/etc/tacse3/calibration.toml\","),
             std::string::npos);
+  info.controls_off = "b.toml: [viewer] controls is not true";
+  EXPECT_NE(view_info_json(info).find(
+                "\"controls\":false,\"controls_off\":\"b.toml: [viewer] controls is not true\"}"),
+            std::string::npos)
+      << view_info_json(info);
 }
 
 TEST_F(ViewServerTest, NothingButTheDocumentedEndpoints) {
@@ -279,4 +344,101 @@ TEST_F(ViewServerTest, StreamsEverySnapshotAndRefusesAFifthClient) {
   }
   EXPECT_TRUE(admitted) << "the closed stream's place was not freed within 4 s";
   for (int s : streams) close(s);
+}
+
+TEST_F(ViewServerTest, CommandsAreRefusedNamingTheBoardKeyWhenTheControlsAreOff) {
+  const std::string r = exchange(port(), post("/api/command", "{\"command\":\"tare\"}"));
+  EXPECT_EQ(status_of(r), 403) << r;
+  EXPECT_EQ(body_of(r), std::string("{\"error\":\"").append(config_.controls_off).append("\"}\n"));
+  EXPECT_NE(config_.controls_off.find("[viewer] controls = true"), std::string::npos);
+  EXPECT_EQ(status_of(exchange(port(), get("/api/command"))), 404) << "POST only";
+}
+
+TEST_F(ViewControlsTest, EachCommandIsThisNodesCanCommandAndTheAckIsTheAnswer) {
+  struct Case {
+    const char* body;
+    protocol::CommandCode code;
+    std::uint8_t arg0;  // the argument byte as the CAN frame carries it
+    const char* answer;
+  };
+  const Case cases[] = {
+      {R"({"command":"tare"})", protocol::CommandCode::kTare, 0,
+       R"({"command":"TARE","ack":true,"code":0,"result":"ACK","sequence":0})"},
+      {R"({"command": "reset_pose"})", protocol::CommandCode::kResetPose, 0,
+       R"({"command":"RESET_POSE","ack":true,"code":0,"result":"ACK","sequence":1})"},
+      {R"({"command":"stream","on":false})", protocol::CommandCode::kSetStream, 0,
+       R"({"command":"SET_STREAM","ack":true,"code":0,"result":"ACK","sequence":2})"},
+      {R"({"on":true,"command":"stream"})", protocol::CommandCode::kSetStream, 1,
+       R"({"command":"SET_STREAM","ack":true,"code":0,"result":"ACK","sequence":3})"},
+  };
+  for (const Case& c : cases) {
+    const std::string r = exchange(port(), post("/api/command", c.body));
+    EXPECT_EQ(status_of(r), 200) << c.body << "\n" << r;
+    EXPECT_EQ(body_of(r), std::string(c.answer) + "\n") << c.body;
+  }
+  const auto got = taken();
+  ASSERT_EQ(got.size(), 4u);
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    // Validated by validate_command as a frame addressed to node 5: the CAN path's checks.
+    EXPECT_TRUE(got[i].addressed);
+    EXPECT_EQ(got[i].code, protocol::AckCode::kAck);
+    EXPECT_EQ(got[i].command.code, cases[i].code);
+    EXPECT_EQ(got[i].command.target_node, 5);
+    EXPECT_EQ(got[i].echo_args[0], cases[i].arg0) << cases[i].body;
+  }
+  EXPECT_FALSE(got[2].command.stream_enabled);
+  EXPECT_TRUE(got[3].command.stream_enabled);
+}
+
+TEST_F(ViewControlsTest, ANackIsA409CarryingTheReason) {
+  nack_ = static_cast<int>(protocol::AckCode::kBusy);
+  const std::string r = exchange(port(), post("/api/command", R"({"command":"tare"})"));
+  EXPECT_EQ(status_of(r), 409) << r;
+  EXPECT_EQ(body_of(r),
+            "{\"command\":\"TARE\",\"ack\":false,\"code\":7,\"result\":\"BUSY\",\"sequence\":0}\n");
+}
+
+TEST_F(ViewControlsTest, NoAnswerFromTheDspThreadIsA504AndTheNextCommandStillWorks) {
+  silent_ = true;
+  const std::string r = exchange(port(), post("/api/command", R"({"command":"tare"})"));
+  EXPECT_EQ(status_of(r), 504) << r;
+  EXPECT_NE(body_of(r).find("did not answer within 300 ms"), std::string::npos) << r;
+  // The late command is still waiting: the next one is refused until it is answered.
+  EXPECT_EQ(status_of(exchange(port(), post("/api/command", R"({"command":"tare"})"))), 503);
+  silent_ = false;
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(status_of(exchange(port(), post("/api/command", R"({"command":"tare"})"))), 200);
+  EXPECT_EQ(taken().size(), 2u);
+}
+
+TEST_F(ViewControlsTest, BadBodiesAreRefusedWithTheExpectedForms) {
+  struct Case {
+    std::string request;
+    int status;
+    const char* message;  // part of the error, as the JSON body spells it
+  };
+  const Case cases[] = {
+      {post("/api/command", ""), 400, "not a JSON object"},
+      {post("/api/command", "tare"), 400, "not a JSON object"},
+      {post("/api/command", "[\"tare\"]"), 400, "not a JSON object"},
+      {post("/api/command", R"({"command":"tare")"), 400, "not a JSON object"},
+      {post("/api/command", R"({})"), 400, R"(\"command\" is missing)"},
+      {post("/api/command", R"({"command":1})"), 400, R"(\"command\" is missing or not a string)"},
+      {post("/api/command", R"({"command":"TARE"})"), 400, R"(unknown command \"TARE\")"},
+      {post("/api/command", R"({"command":"start_recording"})"), 400, "unknown command"},
+      {post("/api/command", R"({"command":"stream"})"), 400, R"(needs \"on\": true or false)"},
+      {post("/api/command", R"({"command":"stream","on":1})"), 400, R"(needs \"on\")"},
+      {post("/api/command", R"({"command":"tare","on":true})"), 400, "unknown key"},
+      {post("/api/command", R"({"command":"stream","on":true,"x":0})"), 400, "unknown key"},
+      {post("/api/command", R"({"command":"tare"})", "application/x-www-form-urlencoded"), 415,
+       "Content-Type: application/json"},
+      {post("/api/command", R"({"command":"tare"})", "text/plain"), 415, "must be JSON"},
+      {post("/api/command", "{\"command\":\"" + std::string(5000, 'a') + "\"}"), 413, ""},
+  };
+  for (const Case& c : cases) {
+    const std::string r = exchange(port(), c.request);
+    EXPECT_EQ(status_of(r), c.status) << c.request.substr(0, 120) << "\n" << r.substr(0, 300);
+    EXPECT_NE(body_of(r).find(c.message), std::string::npos) << r.substr(0, 300);
+  }
+  EXPECT_TRUE(taken().empty()) << "nothing reached the DSP thread";
 }

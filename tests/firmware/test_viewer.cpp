@@ -11,6 +11,7 @@
 #include <turbojpeg.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -115,6 +116,14 @@ TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) 
     }
   }
   ASSERT_FALSE(first.empty()) << "no /api/state within 10 s";
+  // The board leaves the controls off: the command endpoint says which key turns them on.
+  const auto refused = cli.Post("/api/command", R"({"command":"tare"})", "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 403);
+  EXPECT_NE(refused->body.find((dir_ / "board.toml").string() + ": [viewer] controls is not true"),
+            std::string::npos)
+      << refused->body;
+  EXPECT_NE(cli.Get("/api/info")->body.find("\"controls\":false,"), std::string::npos);
 
   // The client that never reads: its stream fills the socket buffers and must stall nothing.
   const int mute = socket(AF_INET, SOCK_STREAM, 0);
@@ -221,6 +230,65 @@ TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) 
   const double t1 = static_cast<double>(b.cycles.back().timestamp_us);
   const double rate = static_cast<double>(b.cycles.size() - 1) / ((t1 - t0) * 1e-6);
   EXPECT_NEAR(rate, 120.0, 1.2) << "cycle rate " << rate << " Hz";
+}
+
+// [viewer] controls = true: a tare posted to the page's endpoint does what the CAN TARE does
+// (test_engine.cpp): the next cycle on the bus carries PoseReset and the identity pose. Its ACK
+// is the HTTP answer and stays off the bus. Paced and looping, so cycles flow while it runs.
+TEST_F(ViewerTest, TareOverHttpIsTheCanTareWithItsAckAsTheAnswer) {
+  std::string text = read_all(dir_ / "board.toml");
+  text.replace(text.find("realtime = false"), 16, "realtime = true");
+  text.replace(text.find("repeat = false"), 14, "repeat = true");
+  std::ofstream(dir_ / "board.toml") << text << "\n[viewer]\ncontrols = true\n";
+  RunResult d;
+  std::thread run([&] { d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 4)); });
+  httplib::Client cli("127.0.0.1", port_);
+  cli.set_connection_timeout(1);
+  cli.set_read_timeout(2);
+  bool live = false;
+  for (int i = 0; i < 100 && !live; ++i) {
+    auto r = cli.Get("/api/state");
+    live = r && r->status == 200;
+    if (!live) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  if (!live) run.join();
+  ASSERT_TRUE(live) << "no /api/state within 10 s\n" << d.out;
+  EXPECT_NE(cli.Get("/api/info")->body.find("\"controls\":true,\"controls_off\":null"),
+            std::string::npos);
+  // The pose moves away from identity first (the object turns once the pads are in contact).
+  double turned_deg = 0;
+  for (int i = 0; i < 100 && turned_deg < 5; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (auto r = cli.Get("/api/state"); r && r->status == 200) {
+      const std::vector<double> q = json_array(r->body, "q");
+      if (q.size() == 4) turned_deg = 2 * std::acos(std::min(1.0, std::abs(q[0]))) * 180 / M_PI;
+    }
+  }
+  EXPECT_GE(turned_deg, 5) << "the pose did not turn within 5 s";
+  const auto tare = cli.Post("/api/command", R"({"command":"tare"})", "application/json");
+  ASSERT_TRUE(tare);
+  EXPECT_EQ(tare->status, 200);
+  EXPECT_EQ(tare->body,
+            "{\"command\":\"TARE\",\"ack\":true,\"code\":0,\"result\":\"ACK\",\"sequence\":0}\n");
+  const auto bad = cli.Post("/api/command", R"({"command":"tare","x":1})", "application/json");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  run.join();
+  ASSERT_EQ(d.status, 0) << d.out;
+
+  tacse3::test::BusEvents b;
+  ASSERT_TRUE(b.feed_log(read_all(dir_ / "bus.log")));
+  EXPECT_TRUE(b.acks.empty()) << "the web command's ACK went on the bus";
+  std::vector<std::size_t> flagged;
+  for (std::size_t i = 0; i < b.cycles.size(); ++i) {
+    if (b.cycles[i].pose_reset) flagged.push_back(i);
+  }
+  ASSERT_EQ(flagged.size(), 1u) << "one tare, one PoseReset cycle";
+  const std::size_t i = flagged[0];
+  EXPECT_NEAR(b.cycles[i].orientation.w, 1.0, 1e-3);
+  const double before_deg =
+      2 * std::acos(std::min(1.0, std::abs(b.cycles[i - 1].orientation.w))) * 180 / M_PI;
+  EXPECT_GE(before_deg, 5) << "the pose before the tare, on the bus";
 }
 
 TEST_F(ViewerTest, BadAddressIsAUsageErrorAndABusyPortAStartError) {

@@ -2,9 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 """tacse3d's live view in headless Chromium (Debian's chromium, chromium-driver, python3-selenium).
 
-Starts tacse3d --board BOARD --http 127.0.0.1:PORT, loads the page and checks that the stream is
-live, the plots move, both pad canvases show an image (not blank), the left pad reads OK, and
-the pose readout matches /api/state on the same cycle. Saves a screenshot to --screenshot.
+Starts tacse3d --board BOARD --http 127.0.0.1:PORT with the board's [viewer] controls on, loads
+the page and checks that the stream is live, the plots move, both pad canvases show an image (not
+blank), the left pad reads OK, the pose readout matches /api/state on the same cycle, and that the
+tare button is answered with an ACK shown on the page and restarts the pose. Saves a screenshot
+to --screenshot.
 Exit 77 (ctest: skipped) with a message when Chromium, its driver or selenium is missing.
 """
 import argparse
@@ -77,8 +79,9 @@ def main():
     with open(args.board) as f:
         text = f.read()
     assert "repeat = false" in text, f"{args.board}: no 'repeat = false' to turn on"
+    assert "[viewer]" not in text, f"{args.board}: has a [viewer] table already"
     with open(board, "w") as f:
-        f.write(text.replace("repeat = false", "repeat = true"))
+        f.write(text.replace("repeat = false", "repeat = true") + "\n[viewer]\ncontrols = true\n")
 
     port = free_port()
     base = f"http://127.0.0.1:{port}"
@@ -141,6 +144,28 @@ def main():
         angle = 2 * math.degrees(math.acos(w))
         assert abs(float(shown) - angle) < 0.006, f"angle shown {shown}, /api/state {angle:.4f}"
         print(f"cycle {api['cycle']}: angle shown {shown} deg, /api/state {angle:.4f} deg")
+
+        # Tare: the ACK on the page, and the pose restarts from identity (it has turned by then:
+        # the scenario rotates 30 degrees about z).
+        def angle_of(q):
+            return 2 * math.degrees(math.acos(min(1.0, abs(q[0]))))
+        page_pose = "return [window.tacse3.last().cycle, window.tacse3.last().pose.q]"
+        assert js("return document.getElementById('controls-off').hidden"), "controls shown off"
+        before = wait_for("the object to turn 8 degrees", lambda: (lambda cq: cq if angle_of(
+            cq[1]) >= 8 else None)(js(page_pose)), 20)
+        browser.find_element("id", "cmd-tare").click()
+        ack = wait_for("the tare's answer on the page", lambda: (lambda t: t if "code" in t else
+                       None)(js("return document.getElementById('ack').textContent")), 5)
+        assert ack == "TARE: ACK (code 0, sequence 0)", f"the page shows {ack!r}"
+        # The snapshot shown when the ACK came may predate the tare; the next one cannot (the DSP
+        # thread applies a command before it answers).
+        shown = js(page_pose)[0]
+        after = wait_for("a cycle after the tare", lambda: (lambda cq: cq if cq[0] > shown
+                         else None)(js(page_pose)), 5)
+        a0, a1 = angle_of(before[1]), angle_of(after[1])
+        assert a1 < a0 / 2, f"pose angle {a0:.2f} deg before the tare, {a1:.2f} deg after"
+        print(f"tare: {ack!r}; pose angle {a0:.2f} deg at cycle {before[0]}, "
+              f"{a1:.2f} deg at cycle {after[0]}")
 
         browser.save_screenshot(args.screenshot)
         print(f"screenshot: {args.screenshot}")

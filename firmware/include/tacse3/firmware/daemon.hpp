@@ -141,9 +141,10 @@ class Daemon {
   std::string recording_path_;
   bool recording_failure_reported_ = false;
   SharedState shared_;
-  // --http / [viewer] listen: the slot the DSP thread publishes into and the server reading it
-  // (declared in this order: the server goes first).
+  // --http / [viewer] listen: the slot the DSP thread publishes into, the controls' mailbox
+  // ([viewer] controls) and the server using both (declared in this order: the server goes first).
   std::unique_ptr<ViewSlot> view_slot_;
+  std::unique_ptr<CommandMailbox> web_commands_;
   std::unique_ptr<ViewServer> view_server_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> dsp_ready_{false};

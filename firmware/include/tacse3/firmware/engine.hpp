@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "tacse3/dsp/pipeline.hpp"
+#include "tacse3/firmware/command_mailbox.hpp"
 #include "tacse3/firmware/health.hpp"
 #include "tacse3/firmware/latency.hpp"
 #include "tacse3/firmware/pairing.hpp"
@@ -105,6 +106,9 @@ class Engine {
   // --http: the slot the live viewer reads (null: no viewer, nothing is published). Set before
   // the DSP thread starts.
   void set_view(ViewSlot* slot) noexcept { view_ = slot; }
+  // [viewer] controls: the mailbox the viewer's POST /api/command writes (null: no controls).
+  // Set before the DSP thread starts.
+  void set_web_commands(CommandMailbox* box) noexcept { web_commands_ = box; }
   // One loop iteration at now_ns (CLOCK_MONOTONIC). Returns true when it did work (the caller
   // sleeps briefly when it did not).
   bool step(std::int64_t now_ns) noexcept;
@@ -130,6 +134,8 @@ class Engine {
   void release_head(std::size_t s) noexcept;
   void process(bool use_left, bool use_right, std::int64_t now_ns) noexcept;
   void handle_command(const protocol::CommandResult& r) noexcept;
+  bool handle_web_command() noexcept;
+  protocol::Ack answer(const protocol::CommandResult& r) noexcept;
   bool recording_command(const protocol::Command& c, protocol::Ack& ack) noexcept;
   bool finish_recording_start() noexcept;
   void tare_and_reset_pose() noexcept;
@@ -182,6 +188,7 @@ class Engine {
   EngineStats stats_{};
   FrameRecorder* recorder_ = nullptr;
   ViewSlot* view_ = nullptr;
+  CommandMailbox* web_commands_ = nullptr;
   std::int64_t next_view_ns_ = INT64_MIN;
   std::int64_t last_dsp_us_ = -1;
   std::int64_t last_latency_us_ = -1;

@@ -13,10 +13,11 @@ namespace tacse3::firmware {
 std::string view_state_json(const ViewSnapshot& v);
 // GET /api/info: what does not change while the daemon runs.
 struct ViewInfo {
-  std::string version;      // tacse3d's
-  std::string board;        // the board's name
-  std::string board_file;   // the file it came from
-  std::string calibration;  // the calibration file, empty: the built-in defaults
+  std::string version;       // tacse3d's
+  std::string board;         // the board's name
+  std::string board_file;    // the file it came from
+  std::string calibration;   // the calibration file, empty: the built-in defaults
+  std::string controls_off;  // why POST /api/command answers 403; empty: the controls are on
 };
 std::string view_info_json(const ViewInfo& info);
 // A JSON string literal of `text`: quotes, backslashes and control characters escaped.

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tacse3/config/listen_address.hpp"
+#include "tacse3/firmware/command_mailbox.hpp"
 #include "tacse3/firmware/view_snapshot.hpp"
 
 namespace tacse3::firmware {
@@ -21,7 +22,17 @@ struct ViewServerConfig {
   int max_streams = 4;           // /api/stream clients at once; more get 503
   int write_timeout_ms = 2000;   // a client that takes no data this long is dropped
   int nice = 10;                 // the server threads' niceness (the DSP thread is SCHED_FIFO)
+  // POST /api/command: the DSP thread's mailbox; null: the controls are off and the endpoint
+  // answers 403 with `controls_off` (which names the board key that enables them).
+  CommandMailbox* commands = nullptr;
+  std::string controls_off = "the controls are off: set [viewer] controls = true in the board file";
+  protocol::Endpoint endpoint{};  // this node: commands are built and validated as its CAN frames
+  int command_timeout_ms = 1000;  // no answer from the DSP thread this long: 504
 };
+
+// POST /api/command's body, as the CAN command it stands for. false with *error (the HTTP 400
+// message) for anything but the documented forms.
+bool parse_web_command(const std::string& body, protocol::Command* command, std::string* error);
 
 // The viewer assets folder: <exe_dir>/../share/tacse3/viewer (the package's and the build
 // tree's). Empty when it holds no index.html.
