@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "free_port.hpp"
 #include "tacse3/firmware/view_json.hpp"
 #include "tacse3/firmware/view_server.hpp"
 #include "tacse3/protocol/commands.hpp"
@@ -28,19 +29,9 @@ namespace fs = std::filesystem;
 using namespace tacse3;
 using namespace tacse3::firmware;
 
-namespace {
+using tacse3::test::free_port;
 
-int free_port() {
-  const int s = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(s, reinterpret_cast<sockaddr*>(&a), sizeof(a));
-  socklen_t n = sizeof(a);
-  getsockname(s, reinterpret_cast<sockaddr*>(&a), &n);
-  close(s);
-  return ntohs(a.sin_port);
-}
+namespace {
 
 int connect_to(int port) {
   const int s = socket(AF_INET, SOCK_STREAM, 0);

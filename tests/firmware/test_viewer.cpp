@@ -23,27 +23,16 @@
 #include <vector>
 
 #include "bus_events.hpp"
+#include "free_port.hpp"
 #include "run_cmd.hpp"
 
 namespace fs = std::filesystem;
+using tacse3::test::free_port;
 using tacse3::test::read_all;
 using tacse3::test::run_cmd;
 using tacse3::test::RunResult;
 
 namespace {
-
-// A port nobody listens on now (the kernel's pick for port 0).
-int free_port() {
-  const int s = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bind(s, reinterpret_cast<sockaddr*>(&a), sizeof(a));
-  socklen_t n = sizeof(a);
-  getsockname(s, reinterpret_cast<sockaddr*>(&a), &n);
-  close(s);
-  return ntohs(a.sin_port);
-}
 
 // The number after "key": in a flat JSON text (the fields used here are unique keys).
 double json_number(const std::string& j, const std::string& key, std::size_t from = 0) {
