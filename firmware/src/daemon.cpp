@@ -7,10 +7,10 @@
 
 #include <cmath>
 #include <cstdarg>
-#include <thread>
 
 #include "tacse3/dsp/se3.hpp"
 #include "tacse3/firmware/system.hpp"
+#include "tacse3/firmware/thread.hpp"
 #if TACSE3_HAVE_VIEWER
 #include "tacse3/firmware/view_json.hpp"
 #include "tacse3/firmware/view_server.hpp"
@@ -51,6 +51,14 @@ constexpr int kCaptureTimeoutMs = 100;  // bounds how long a capture thread take
 constexpr int kRxTimeoutMs = 100;
 constexpr std::int64_t kIdleSleepNs = 200'000;  // DSP loop with nothing to do (docs: latency)
 constexpr std::size_t kDspStackPrefault = 256 * 1024;
+// Stack sizes (docs/performance.md, "Thread stacks"): mlockall(MCL_FUTURE) keeps every byte of
+// a thread's stack resident, so each thread gets what it was measured to touch, with a margin.
+// DSP: the prefault plus 256 KiB (measured: 12 KiB touched beyond the prefault). Capture and
+// RX: high-water marks of 16 and 8 KiB on the sim and replay boards; 128 KiB leaves 8x for the
+// V4L2 and libcamera paths, which cannot be measured off the board.
+constexpr std::size_t kDspStack = kDspStackPrefault + 256 * 1024;
+constexpr std::size_t kCaptureStack = 128 * 1024;
+constexpr std::size_t kRxStack = 128 * 1024;
 
 hal::LedState led_state(protocol::State s) noexcept {
   switch (s) {
@@ -761,7 +769,7 @@ int Daemon::run(bool handle_signals) {
   // The DSP thread first: its real-time setup (mlockall, stack prefault) can take a while, and
   // frames that arrive before it runs would overflow the capture rings (a replayed recording
   // would lose its first frames, which hold the reference). Cameras start once it is looping.
-  std::thread dsp([this] { dsp_loop(); });
+  Thread dsp(kDspStack, [this] { dsp_loop(); });
   for (int i = 0; i < 2000 && !dsp_ready_.load(std::memory_order_acquire); ++i) sleep_ns(1'000'000);
   for (std::size_t s = 0; s < 2; ++s) {
     if (!cameras_[s]) continue;
@@ -773,11 +781,11 @@ int Daemon::run(bool handle_signals) {
       return 1;
     }
   }
-  std::array<std::thread, 2> capture;
+  std::array<Thread, 2> capture;
   for (std::size_t s = 0; s < 2; ++s) {
-    if (cameras_[s]) capture[s] = std::thread([this, s] { capture_loop(s); });
+    if (cameras_[s]) capture[s] = Thread(kCaptureStack, [this, s] { capture_loop(s); });
   }
-  std::thread rx([this] { rx_loop(); });
+  Thread rx(kRxStack, [this] { rx_loop(); });
 
   while (!stop_.load(std::memory_order_acquire)) {
     gpio_controller_->poll(5);  // also the housekeeping tick's sleep

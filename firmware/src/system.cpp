@@ -36,6 +36,10 @@ __attribute__((noinline)) void prefault_stack(std::size_t bytes) noexcept {
 RealtimeResult setup_realtime_thread(int priority, int cpu, std::size_t stack_bytes) noexcept {
   RealtimeResult r;
   std::string missing;
+  // Everything, now and later: the DSP path runs through the program, its libraries, its heap
+  // and its stack, and must take no page fault after start. Locking only those ranges, or
+  // MCL_ONFAULT, would spare untouched pages but let a rarely taken branch fault on the DSP
+  // path. Sized thread stacks (Thread) keep what MCL_FUTURE locks small (docs/performance.md).
   if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
     r.locked = true;
   } else {

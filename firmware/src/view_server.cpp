@@ -14,13 +14,16 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
+#include <vector>
 
+#include "tacse3/firmware/thread.hpp"
 #include "tacse3/firmware/view_json.hpp"
 #include "tacse3/protocol/commands.hpp"
 
@@ -31,6 +34,13 @@ namespace {
 constexpr int kJpegQuality = 85;
 constexpr auto kSamplePoll = std::chrono::milliseconds(10);
 constexpr auto kStreamHeartbeat = std::chrono::seconds(1);
+// Stack sizes (docs/performance.md, "Thread stacks"): under the daemon's mlockall(MCL_FUTURE)
+// every byte of a stack is resident. Measured high-water marks while serving the page, every
+// endpoint and an event stream: sampler (JSON, JPEG encoding) 12 KiB, listener 12 KiB, pool
+// threads 20 KiB; 128 KiB leaves at least 6x.
+constexpr std::size_t kSamplerStack = 128 * 1024;
+constexpr std::size_t kListenerStack = 128 * 1024;
+constexpr std::size_t kPoolStack = 128 * 1024;
 
 // A rendered snapshot, shared by every request that serves it.
 struct Rendered {
@@ -104,6 +114,63 @@ std::string ack_json(const protocol::Ack& a) {
   return s;
 }
 
+// httplib's ThreadPool with sized stacks: the server takes its task queue from us, and httplib's
+// own pool starts std::threads with the default 8 MiB stack.
+class SizedPool final : public httplib::TaskQueue {
+ public:
+  SizedPool(std::size_t n, std::size_t stack_bytes) {
+    workers_.reserve(n);
+    try {
+      for (std::size_t i = 0; i < n; ++i) workers_.emplace_back(stack_bytes, [this] { work(); });
+    } catch (...) {
+      shutdown();
+      throw;
+    }
+  }
+  ~SizedPool() override { shutdown(); }
+
+  void enqueue(std::function<void()> fn) override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      jobs_.push_back(std::move(fn));
+    }
+    cond_.notify_one();
+  }
+
+  // Runs the jobs already queued, then joins every worker.
+  void shutdown() override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+    }
+    cond_.notify_all();
+    for (auto& t : workers_) {
+      if (t.joinable()) t.join();
+    }
+  }
+
+ private:
+  void work() {
+    for (;;) {
+      std::function<void()> fn;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cond_.wait(lock, [this] { return !jobs_.empty() || stopping_; });
+        if (jobs_.empty()) return;
+        fn = std::move(jobs_.front());
+        jobs_.pop_front();
+      }
+      fn();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable cond_;
+  std::deque<std::function<void()>> jobs_;  // guarded by mutex_
+  bool stopping_ = false;                   // guarded by mutex_
+  std::vector<Thread> workers_;             // last: started once the rest exists
+};
+
 // Linux: nice is per thread, and threads inherit it from the thread that creates them.
 void lower_priority(int nice) {
   setpriority(PRIO_PROCESS, 0, nice);
@@ -168,8 +235,8 @@ struct ViewServer::Impl {
   std::atomic<std::uint64_t> snapshots{0};
   std::atomic<std::uint64_t> refused{0};
   std::atomic<std::uint64_t> dropped{0};
-  std::thread sampler;
-  std::thread listener;
+  Thread sampler;
+  Thread listener;
 
   std::shared_ptr<const Rendered> current() const {
     std::lock_guard<std::mutex> lock(mutex);
@@ -377,7 +444,9 @@ std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, Vi
   }
   httplib::Server& sv = impl->server;
   const int threads = config.threads;
-  sv.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
+  sv.new_task_queue = [threads] {
+    return new SizedPool(static_cast<std::size_t>(threads), kPoolStack);
+  };
   // SO_REUSEADDR only: a restart binds at once, but a second daemon on the same port fails
   // (httplib's default adds SO_REUSEPORT, which would let both listen).
   sv.set_socket_options([](socket_t sock) {
@@ -401,8 +470,8 @@ std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, Vi
     return nullptr;
   }
   Impl* p = impl.get();
-  p->sampler = std::thread([p] { p->sample_loop(); });
-  p->listener = std::thread([p] {
+  p->sampler = Thread(kSamplerStack, [p] { p->sample_loop(); });
+  p->listener = Thread(kListenerStack, [p] {
     lower_priority(p->config.nice);  // before the pool threads exist: they inherit it
     p->server.listen_after_bind();
   });
