@@ -40,7 +40,8 @@ field() {  # field PID NAME -> value from /proc/PID/status (KiB for the Vm* fiel
 }
 
 # stacks PID -> KiB resident in anonymous mappings of exactly the default thread stack size
-# (ulimit -s): the threads' stacks, which mlockall(MCL_FUTURE) makes resident in full.
+# (ulimit -s): the stacks of threads created without an explicit size (the daemon sizes its own,
+# bench/memory/thread-stacks.py), which mlockall makes resident in full.
 STACK_KIB=$(ulimit -s)
 stacks() {
   awk -v want="$STACK_KIB" '

@@ -4,12 +4,14 @@
 # (VmRSS) and open file descriptors sampled once a second. After a warm-up (the first quarter of
 # the samples) both must stay flat: RSS within 1 MiB of its value after the warm-up, and the
 # fewest fds seen in the last quarter no more than the fewest in the second. The floor, not the
-# peak: any sample may catch a frame's PNG open, but a leak raises every later sample.
+# peak: any sample may catch a frame's PNG open, but a leak raises every later sample. With
+# PEAK_MIB, the peak resident set (VmHWM) must also stay below it (docs/performance.md, Memory).
 #
-# Usage: run.sh BUILD_DIR [SECONDS]      (ctest firmware_soak: 20 s; docs/testing.md: longer runs)
+# Usage: run.sh BUILD_DIR [SECONDS [PEAK_MIB]]   (ctest firmware_soak: 20 s, docs/testing.md)
 set -uo pipefail
-B="${1:?usage: run.sh BUILD_DIR [SECONDS]}"
+B="${1:?usage: run.sh BUILD_DIR [SECONDS [PEAK_MIB]]}"
 seconds="${2:-20}"
+peak_mib="${3:-0}"
 T=$(mktemp -d "${TMPDIR:-/tmp}/tacse3-soak.XXXXXX")
 trap 'kill "$pid" 2>/dev/null; rm -rf "$T"' EXIT
 pid=""
@@ -32,8 +34,9 @@ pid=$!
 : >"$T/samples"
 while kill -0 "$pid" 2>/dev/null; do
   rss=$(awk '/^VmRSS:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
+  hwm=$(awk '/^VmHWM:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
   fds=$(find "/proc/$pid/fd" -mindepth 1 2>/dev/null | wc -l)
-  [ -n "$rss" ] && echo "$rss $fds" >>"$T/samples"
+  [ -n "$rss" ] && echo "$rss $fds $hwm" >>"$T/samples"
   sleep 1
 done
 wait "$pid"
@@ -45,8 +48,8 @@ if [ "$rc" -ne 0 ] || [ -z "$summary" ]; then
 fi
 n=$(wc -l <"$T/samples")
 [ "$n" -ge 4 ] || { echo "FAIL: only $n samples" >&2; exit 1; }
-awk -v n="$n" -v summary="$summary" '
-  { rss[NR] = $1; fds[NR] = $2 }
+awk -v n="$n" -v summary="$summary" -v peak_mib="$peak_mib" '
+  { rss[NR] = $1; fds[NR] = $2; if ($3 > hwm) hwm = $3 }
   END {
     w = int(n / 4) + 1
     base = rss[w]; top = base; early = -1; late = -1
@@ -56,8 +59,9 @@ awk -v n="$n" -v summary="$summary" '
       if (i > n - w && (late < 0 || fds[i] < late)) late = fds[i]
     }
     printf "soak: %s\n", summary
-    printf "soak: %d samples; after warm-up RSS %d -> %d kB (max %d), fds at least %d early, %d late\n", n, base, rss[n], top, early, late
+    printf "soak: %d samples; after warm-up RSS %d -> %d kB (max %d), fds at least %d early, %d late; peak RSS %d kB\n", n, base, rss[n], top, early, late, hwm
     bad = 0
+    if (peak_mib > 0 && hwm > peak_mib * 1024) { printf "FAIL: peak RSS above %d MiB\n", peak_mib; bad = 1 }
     if (late > early) { print "FAIL: more open descriptors at the end than after the warm-up"; bad = 1 }
     if (top - base > 1024) { print "FAIL: RSS grew by more than 1 MiB after the warm-up"; bad = 1 }
     exit bad
