@@ -116,7 +116,7 @@ TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) 
       [&] { d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 6 * kTimeScale)); })};
   httplib::Client cli("127.0.0.1", port_);
   cli.set_connection_timeout(1);
-  cli.set_read_timeout(2);
+  cli.set_read_timeout(2 * kTimeScale);
   std::string first;
   for (int i = 0; i < 100 && first.empty(); ++i) {
     if (auto r = cli.Get("/api/state"); r && r->status == 200) {
@@ -154,7 +154,7 @@ TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) 
   for (int k = 0; k < 3; ++k) {
     readers.emplace_back([&, k] {
       httplib::Client c("127.0.0.1", port_);
-      c.set_read_timeout(3);
+      c.set_read_timeout(3 * kTimeScale);
       std::string buf;
       c.Get("/api/stream", [&](const char* data, std::size_t n) {
         buf.append(data, n);
@@ -257,7 +257,7 @@ TEST_F(ViewerTest, TareOverHttpIsTheCanTareWithItsAckAsTheAnswer) {
       [&] { d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 4 * kTimeScale)); })};
   httplib::Client cli("127.0.0.1", port_);
   cli.set_connection_timeout(1);
-  cli.set_read_timeout(2);
+  cli.set_read_timeout(2 * kTimeScale);
   bool live = false;
   for (int i = 0; i < 100 && !live; ++i) {
     auto r = cli.Get("/api/state");
