@@ -88,7 +88,10 @@ check "replay --out full: no partial CSV" test ! -e "$T/m_out/out.csv"
 # 4. tacse3-canmon to a full stdout: exit 1, says the output is incomplete.
 "$CANMON" --log "$T/can1.log" --format csv >"$T/m_out/mon.csv" 2>"$T/e4"
 check "canmon stdout full: exit 1" test $? -eq 1
-check "canmon stdout full: says so" has "$T/e4" "write error (No space left on device); the output is incomplete"
+# The cause is named when the final flush is what fails; a write that failed earlier leaves only
+# the stream's error flag (tools/cli/include/tacse3/tools/cli.hpp, finish_stdout), and which of
+# the two happens depends on how much the log holds.
+check "canmon stdout full: says so" grep -q "standard output: write error.*; the output is incomplete" "$T/e4"
 
 # 5. tacse3-dbcgen -o on a full disk: exit 1, no file (written atomically).
 rm -f "$T/m_out/mon.csv"
