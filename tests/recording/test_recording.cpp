@@ -285,6 +285,22 @@ TEST(Recording, BadPngFilesAreNamed) {
     ASSERT_TRUE(write_png(tmp.path() / "right" / "000002.png", view(im), 1));
     expect_error(tmp.path(), {"right/000002.png", "30x24", "32x24"});
   }
+  {  // a header that claims 30720x65280 (found by fuzz_png): refused before any allocation
+    TempDir tmp;
+    fs::create_directories(tmp.path());
+    const fs::path p = tmp.path() / "huge.png";
+    const unsigned char bytes[] = {0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00,
+                                   0x00, 0x0d, 0x49, 0x48, 0x44, 0x52, 0x00, 0x00, 0x78, 0x00,
+                                   0x00, 0x00, 0xff, 0x00, 0x08, 0x02, 0x00, 0x00, 0x00};
+    write_file(p, std::string(reinterpret_cast<const char*>(bytes), sizeof(bytes)));
+    Image im;
+    const Status s = read_png(p, &im);
+    ASSERT_FALSE(s);
+    EXPECT_NE(s.message().find("huge.png: PNG is larger than 4096 pixels on a side"),
+              std::string::npos)
+        << s.message();
+    EXPECT_TRUE(im.pixels.empty());
+  }
   {  // 16-bit and RGBA PNGs, written by hand-made headers
     for (int which = 0; which < 2; ++which) {
       TempDir tmp;

@@ -155,6 +155,9 @@ struct PngHeader {
   int colour_type = 0;
 };
 Status read_png_header(const std::filesystem::path& file, PngHeader* out);
+// Largest PNG side read_png decodes: far above any tactile camera, and it bounds the buffer a
+// header can ask for (8-bit RGB: 48 MiB).
+inline constexpr int kMaxPngSide = 4096;
 Status read_png(const std::filesystem::path& file, Image* out);  // reuses out->pixels
 Status write_png(const std::filesystem::path& file, const ImageView& image, int compression_level);
 
