@@ -387,13 +387,14 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     // Rule of the sliding regime: mask centroid, or the common points if the mask jumped.
     Eigen::Vector2d slide_disp = Eigen::Vector2d::Zero();
     TranslationSource slide_source = TranslationSource::kNone;
-    Eigen::Vector2d common_disp = Eigen::Vector2d::Zero();
-    if (common > 0) {
-      const double nc = static_cast<double>(common);
-      common_disp =
-          Eigen::Vector2d(static_cast<double>(common_dx), static_cast<double>(common_dy)) / nc *
-          kNm;
-    }
+    // Mean displacement (m) of n material points from their summed steps (nm); 0 for none.
+    const auto mean_step = [](std::int64_t dx, std::int64_t dy, std::int64_t n) {
+      return n > 0 ? Eigen::Vector2d(
+                         Eigen::Vector2d(static_cast<double>(dx), static_cast<double>(dy)) /
+                         static_cast<double>(n) * kNm)
+                   : Eigen::Vector2d::Zero();
+    };
+    const Eigen::Vector2d common_disp = mean_step(common_dx, common_dy, common);
     if (common == 0) {
       // Ω_t and Ω_{t−1} share no cell: unrelated contacts (one vanished as another appeared),
       // not a slide, which moves a patch by a fraction of its size per frame. No translation.
@@ -424,11 +425,8 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
       // compresses it ahead, which moves Ω (read from 𝒢) backwards although nothing slid. For
       // the same reason the mean is over the anchored patch when it has common points: Ω grows
       // over stretched gel that lags the object, which would dilute the mean.
-      disp = anchored_common > 0
-                 ? Eigen::Vector2d(Eigen::Vector2d(static_cast<double>(anchored_dx),
-                                                   static_cast<double>(anchored_dy)) /
-                                   static_cast<double>(anchored_common) * kNm)
-                 : common_disp;
+      disp =
+          anchored_common > 0 ? mean_step(anchored_dx, anchored_dy, anchored_common) : common_disp;
       out.translation_source = TranslationSource::kCommonPoints;
       out.translation_valid = true;
     } else if (slide_source != TranslationSource::kNone) {
