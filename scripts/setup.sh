@@ -13,6 +13,8 @@ export DEBIAN_FRONTEND=noninteractive
 PACKAGES=(
   # toolchain and build
   build-essential cmake ninja-build pkg-config git file clang clang-format
+  # a compiler cache: the arm64 package build reuses the aarch64 test build's objects
+  ccache
   # cross builds for the Raspberry Pi targets, run under qemu-user
   g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user-static
   # libraries

@@ -13,6 +13,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 JOBS="${TACSE3_JOBS:-$(nproc)}"
+# With ccache (scripts/setup.sh installs it), builds that compile the same sources with the same
+# flags share objects: the arm64 package build (scripts/package.sh) is then mostly cache hits on
+# the aarch64 build. Relative to the source tree, so build directories of equal depth match.
+# TACSE3_NO_CCACHE=1 turns it off; a launcher the caller set is kept.
+if [ "${TACSE3_NO_CCACHE:-0}" != 1 ] && command -v ccache >/dev/null; then
+  export CMAKE_C_COMPILER_LAUNCHER="${CMAKE_C_COMPILER_LAUNCHER:-ccache}"
+  export CMAKE_CXX_COMPILER_LAUNCHER="${CMAKE_CXX_COMPILER_LAUNCHER:-ccache}"
+  export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$PWD}"
+fi
 presets=("$@")
 if [ ${#presets[@]} -eq 0 ]; then presets=(host host-sanitize aarch64); fi
 
