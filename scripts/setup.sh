@@ -24,6 +24,8 @@ PACKAGES=(
   libopencv-video-dev
   # hardware backends: MJPEG decode, GPIO, libcamera
   libturbojpeg0-dev libgpiod-dev libcamera-dev
+  # tacse3-replay --plot: SVG and PNG figures (host builds only; docs/replay.md)
+  libcairo2-dev
   # tacse3d --http, the live viewer: the HTTP server (docs/viewer.md says why this one)
   libcpp-httplib-dev
   # its browser test (tests/firmware/viewer): headless Chromium driven by selenium

@@ -3,16 +3,23 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <utility>
 
 #include "tacse3/config/calibration_file.hpp"
+#include "tacse3/fileio/file_io.hpp"
 #include "tacse3/tools/can_log.hpp"
 #include "tacse3/tools/cli.hpp"
 #include "tacse3/tools/field_dump.hpp"
+#include "tacse3/tools/plot_layout.hpp"
 #include "tacse3/tools/progress.hpp"
 #include "tacse3/tools/replay.hpp"
+#include "tacse3/tools/replay_plot.hpp"
 #include "tacse3/tools/source.hpp"
+#if TACSE3_HAVE_PLOT
+#include "tacse3/tools/plot_render.hpp"
+#endif
 
 namespace {
 
@@ -53,6 +60,60 @@ void print_tracking(std::FILE* report, const tt::TrackingError& t) {
                t.translation_rms_mm, t.translation_max_mm, t.translation_lag_s * 1e3);
 }
 
+// "--plot MSG" (built up in place: GCC 12 -O3 warns -Wrestrict on "literal" + std::string).
+std::string plot_error(const std::string& msg) {
+  std::string s = "--plot ";
+  s += msg;
+  return s;
+}
+
+// --plot FILE: refused before the replay runs when it cannot be written (no cairo, no such
+// folder, a directory or device); written atomically after it, so a failure leaves no part.
+std::string plot_check(const std::string& file) {
+#if TACSE3_HAVE_PLOT
+  std::string err;
+  if (!tacse3::fileio::check_output_file(file, &err)) return plot_error(err);
+  return "";
+#else
+  return plot_error(file +
+                    ": this tacse3-replay was built without plotting (cairo, libcairo2-dev, was "
+                    "not found when it was configured)");
+#endif
+}
+
+// The figure's title: recording, method and mode, calibration file (or UNCALIBRATED).
+std::string plot_title(const std::string& rec_dir, const tt::ReplayOptions& opt,
+                       const std::string& mode, const std::string& cal_file) {
+  namespace fs = std::filesystem;
+  fs::path rec = fs::path(rec_dir).lexically_normal();
+  if (rec.filename().empty()) rec = rec.parent_path();
+  std::string t = rec.filename().string();
+  t += ": method ";
+  t += tt::method_name(opt.method);
+  t += ", mode ";
+  t += mode;
+  t += ", ";
+  t += opt.calibration.fitted ? fs::path(cal_file).filename().string() : "UNCALIBRATED";
+  return t;
+}
+
+std::string write_plot(const std::string& file, const tt::SourceInfo& info,
+                       const std::vector<tt::FrameResult>& frames, const tt::RunSummary& sum,
+                       std::string title) {
+  tt::plot::PlotData d = tt::plot::replay_plot_data(info, frames, sum.tracking);
+  d.title = std::move(title);
+#if TACSE3_HAVE_PLOT
+  std::string bytes, err;
+  if (!tt::plot::render(d, *tt::plot::format_from_path(file), &bytes, &err)) {
+    return plot_error(file + ": " + err);
+  }
+  if (!tacse3::fileio::write_file_atomically(file, bytes, &err)) return plot_error(err);
+  return "";
+#else
+  return plot_check(file);
+#endif
+}
+
 // An output file that run() created is removed unless the run completed: a recording that fails
 // half way (a corrupt PNG, a full disk) leaves no partial CSV behind.
 struct RemoveUnlessKept {
@@ -71,7 +132,7 @@ int run(int argc, char** argv) {
       "Replays a tacse3 recording through the firmware's fixed-point pipeline (dsp::DualPipeline) "
       "and writes the estimated twist and pose per frame (docs/replay.md)."};
   std::string rec_dir, cal_file, out_file, method = "joint", mode = "auto", sensors = "both";
-  std::string dump_dir, can_log, slip_log;
+  std::string dump_dir, can_log, slip_log, plot_file;
   bool quiet = false;
   const CLI::Validator path = tt::non_empty_path();
   app.add_option("REC_DIR", rec_dir, "recording directory (docs/recording-format.md)")
@@ -98,6 +159,20 @@ int run(int argc, char** argv) {
   app.add_option("--slip-log", slip_log,
                  "write the stick/slip detector's per-frame decision and features as CSV")
       ->check(path);
+  app.add_option("--plot", plot_file,
+                 "write a figure of the estimate against the truth and the tracking error over "
+                 "time; the extension picks SVG or PNG")
+      ->check(path)
+      ->check(CLI::Validator(
+          [](std::string& f) {
+            std::string e;
+            if (!tt::plot::format_from_path(f)) {
+              e = f;
+              e += ": the name must end in .svg or .png (the extension picks the format)";
+            }
+            return e;
+          },
+          "FILE.svg|FILE.png"));
   app.add_flag("-q,--quiet", quiet, "no progress bar and no summary");
   if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
@@ -106,6 +181,9 @@ int run(int argc, char** argv) {
   (void)tt::parse_mode(mode, &opt.mode);
   (void)tt::parse_sensors(sensors, &opt.sensors);
   std::string err;
+  if (!plot_file.empty()) {
+    if (err = plot_check(plot_file); !err.empty()) return fail(err);
+  }
   auto source = tt::RecordingSource::open(rec_dir, &err);
   if (!source) return fail(err);
   const tt::SourceInfo& info = source->info();
@@ -194,11 +272,18 @@ int run(int argc, char** argv) {
   if (sinks.can != nullptr) {
     if (err = can.close(); !err.empty()) return fail(err);
   }
+  const tt::RunSummary sum = tt::summarize(info, run.frames, opt.sensors);
+  if (!plot_file.empty()) {
+    if (err =
+            write_plot(plot_file, info, run.frames, sum, plot_title(rec_dir, opt, mode, cal_file));
+        !err.empty()) {
+      return fail(err);
+    }
+  }
   csv_guard.keep = true;
   slip_guard.keep = true;
   if (quiet) return 0;
 
-  const tt::RunSummary sum = tt::summarize(info, run.frames, opt.sensors);
   const char* used =
       setup.use[0] && setup.use[1] ? "left+right" : (setup.use[0] ? "left" : "right");
   std::fprintf(report, "tacse3-replay: %s: %zu frames (%s), method %s, mode %s%s, calibration %s\n",

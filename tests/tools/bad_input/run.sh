@@ -34,7 +34,8 @@ done
 
 # --- fixtures ---------------------------------------------------------------------------------
 F="$T/f"
-mkdir -p "$F/dir" "$F/out"
+mkdir -p "$F/dir" "$F/out" "$F/dir.svg"
+ln -s /dev/full "$F/full.png"
 "${prog[sim]}" -q --out "$F/rec" --object sphere --motion rz --magnitude 2 --colour grey \
   --approach-s 0.02 --grasp-s 0.1 --settle-s 0.02 --hold-s 0.02 ||
   { echo "FAIL: tacse3-sim could not make the fixture recording" >&2; exit 1; }
