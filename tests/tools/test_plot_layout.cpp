@@ -172,7 +172,7 @@ TEST(ReplayPlotData, EstimateOnTheTruthCoincides) {
   // The error panels: no point before the motion starts (frame 0 moves along x), 0 after.
   const auto& rot_err = d.panels[6].series[0].y;
   EXPECT_EQ(d.panels[6].series[0].role, tp::Role::kError);
-  EXPECT_EQ(d.panels[6].series[0].label, "error (truth lag 0 ms)");
+  EXPECT_EQ(d.panels[6].series[0].label, "error (lag 0 ms)");
   EXPECT_TRUE(tr.valid);
   for (std::size_t i = 0; i < rot_err.size(); ++i) {
     if (info.t_ns[i] < tr.start_ns) {

@@ -76,8 +76,8 @@ std::string plot_check(const std::string& file) {
   return "";
 #else
   return plot_error(file +
-                    ": this tacse3-replay was built without plotting (cairo, libcairo2-dev, was "
-                    "not found when it was configured)");
+                    ": this tacse3-replay was built without plotting (a host build with "
+                    "libcairo2-dev draws it; docs/replay.md)");
 #endif
 }
 

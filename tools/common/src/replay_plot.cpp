@@ -34,7 +34,7 @@ std::string heading(int c) {
 
 std::string lag_label(const char* what, double lag_s) {
   char buf[64];
-  std::snprintf(buf, sizeof(buf), "%s (truth lag %.0f ms)", what, lag_s * 1e3);
+  std::snprintf(buf, sizeof(buf), "%s (lag %.0f ms)", what, lag_s * 1e3);
   return buf;
 }
 
