@@ -85,6 +85,15 @@ check "replay --out full: exit 1" test "$rc" -eq 1
 check "replay --out full: names the file" has "$T/e3" "$T/m_out/out.csv: write error"
 check "replay --out full: no partial CSV" test ! -e "$T/m_out/out.csv"
 
+# 3b. tacse3-replay --plot on a full disk: exit 1, neither the figure nor the CSV left.
+disk m_plot 64k 60000
+"$REPLAY" "$T/rec3" --out "$T/plot.csv" --plot "$T/m_plot/fig.png" -q 2>"$T/e3b"
+rc=$?
+check "replay --plot full: exit 1" test "$rc" -eq 1
+check "replay --plot full: names the file" has "$T/e3b" "--plot $T/m_plot/fig.png"
+check "replay --plot full: no partial figure" sh -c "! ls -A '$T/m_plot' | grep -v '^fill$'"
+check "replay --plot full: no CSV" test ! -e "$T/plot.csv"
+
 # 4. tacse3-canmon to a full stdout: exit 1, says the output is incomplete.
 "$CANMON" --log "$T/can1.log" --format csv >"$T/m_out/mon.csv" 2>"$T/e4"
 check "canmon stdout full: exit 1" test $? -eq 1
