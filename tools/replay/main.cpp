@@ -104,9 +104,9 @@ std::string write_plot(const std::string& file, const tt::SourceInfo& info,
   d.title = std::move(title);
 #if TACSE3_HAVE_PLOT
   std::string bytes, err;
-  if (!tt::plot::render(d, *tt::plot::format_from_path(file), &bytes, &err)) {
-    return plot_error(file + ": " + err);
-  }
+  const bool drawn = tt::plot::render(d, *tt::plot::format_from_path(file), &bytes, &err);
+  tt::plot::release_static_data();
+  if (!drawn) return plot_error(file + ": " + err);
   if (!tacse3::fileio::write_file_atomically(file, bytes, &err)) return plot_error(err);
   return "";
 #else

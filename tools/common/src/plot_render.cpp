@@ -5,6 +5,7 @@
 
 #include <cairo-svg.h>
 #include <cairo.h>
+#include <fontconfig/fontconfig.h>
 
 #include <cmath>
 #include <memory>
@@ -191,6 +192,11 @@ bool render(const PlotData& d, Format format, std::string* out, std::string* err
   if (failed(cairo_surface_status(surface.get()), error)) return false;
   *out = std::move(bytes);
   return true;
+}
+
+void release_static_data() noexcept {
+  cairo_debug_reset_static_data();
+  FcFini();
 }
 
 }  // namespace tacse3::tools::plot

@@ -23,4 +23,9 @@ inline constexpr Rgb kNoteColour{180, 0, 0};        // PlotData::note, e.g. "no 
 // file in *out. False with *error set when cairo fails.
 bool render(const PlotData& d, Format format, std::string* out, std::string* error);
 
+// cairo and fontconfig keep the fonts they loaded in process-wide caches. A program calls this
+// after its last render(), with no cairo object alive, so the sanitizer build's leak check finds
+// them freed.
+void release_static_data() noexcept;
+
 }  // namespace tacse3::tools::plot
