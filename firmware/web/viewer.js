@@ -19,6 +19,77 @@ function angleAxis(q) {
   return s < 1e-12 ? { angle: 0, axis: [0, 0, 1] } : { angle, axis: [x / s, y / s, z / s] };
 }
 
+// --- 3D view: G's axes and the object's frame, a fixed orthographic oblique projection ---
+// The view looks at G's origin from the direction EYE (in G), with G's x axis (along the fingers)
+// pointing up the screen. The object's frame is G's moved by the pose: axes R(q) e_i from the
+// origin p (docs/recording-format.md: g(t) = R(q) g0 + p), p magnified POSE_P_SCALE times.
+const POSE_AXIS_MM = 10;      // every drawn axis is 10 mm long
+const POSE_P_SCALE = 5;       // the displacement p is drawn 5x
+const POSE_PX_PER_MM = 9;     // canvas pixels per (drawn) millimetre
+const EYE = [0.45, -0.55, 0.70];
+const UP = [1, 0, 0];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                         a[0] * b[1] - a[1] * b[0]];
+const unit = (a) => { const n = Math.hypot(...a); return a.map((x) => x / n); };
+// The screen's right and up directions in G: right = up x eye, up' = eye x right.
+function viewBasis(eye, up) {
+  const e = unit(eye);
+  const right = unit(cross(up, e));
+  return { right, up: cross(e, right) };
+}
+// R(q) v for a unit quaternion [w, x, y, z] (Hamilton): v + 2w (u x v) + 2 u x (u x v).
+function rotate(q, v) {
+  const u = [q[1], q[2], q[3]];
+  const t = cross(u, v).map((c) => 2 * c);
+  const ut = cross(u, t);
+  return [0, 1, 2].map((i) => v[i] + q[0] * t[i] + ut[i]);
+}
+// A point of G in mm to canvas pixels (centre cx, cy; the canvas y axis points down).
+function project(basis, cx, cy, g) {
+  return [cx + POSE_PX_PER_MM * dot(basis.right, g), cy - POSE_PX_PER_MM * dot(basis.up, g)];
+}
+// The end points to draw: G's origin and axis tips, the object's origin and axis tips, in pixels.
+function poseAxes(q, p, cx, cy) {
+  const basis = viewBasis(EYE, UP);
+  const e = [[POSE_AXIS_MM, 0, 0], [0, POSE_AXIS_MM, 0], [0, 0, POSE_AXIS_MM]];
+  const o = p.map((x) => (x === null ? 0 : x * 1e3 * POSE_P_SCALE));
+  const at = (g) => project(basis, cx, cy, g);
+  return {
+    g: { origin: at([0, 0, 0]), axes: e.map(at) },
+    object: { origin: at(o), axes: e.map((v) => at(rotate(q, v).map((c, i) => c + o[i]))) },
+  };
+}
+const AXIS_COLOURS = ['#d62728', '#2ca02c', '#1f77b4'];  // x red, y green, z blue
+function drawFrame(g, f, width, dash, label) {
+  g.lineWidth = width;
+  g.setLineDash(dash);
+  f.axes.forEach((tip, i) => {
+    g.strokeStyle = AXIS_COLOURS[i];
+    g.beginPath();
+    g.moveTo(f.origin[0], f.origin[1]);
+    g.lineTo(tip[0], tip[1]);
+    g.stroke();
+    g.fillStyle = AXIS_COLOURS[i];
+    g.fillText(label + 'xyz'[i], tip[0] + 3, tip[1] - 3);
+  });
+  g.setLineDash([]);
+}
+let drawnPose = null;  // what the 3D view drew last (the browser test reads it)
+function drawPose3d(q, p, truth) {
+  const canvas = $('pose3d');
+  const g = canvas.getContext('2d');
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  g.font = '12px sans-serif';
+  const cx = canvas.width / 2, cy = canvas.height / 2;
+  const a = poseAxes(q, p, cx, cy);
+  drawFrame(g, a.g, 1, [2, 3], 'G ');
+  if (truth) drawFrame(g, poseAxes(truth.q, truth.p, cx, cy).object, 1.5, [6, 4], 'truth ');
+  drawFrame(g, a.object, 3, [], '');
+  drawnPose = { q, p, basis: viewBasis(EYE, UP), cx, cy, axis_mm: POSE_AXIS_MM,
+                p_scale: POSE_P_SCALE, px_per_mm: POSE_PX_PER_MM, ...a };
+}
+
 // --- plots ---
 const series = { t: [], w: [[], [], []], v: [[], [], []], rot: [[], [], []], area: [[], []],
                  conf: [], dsp: [], latency: [] };
@@ -91,6 +162,7 @@ function show(s) {
   $('angle').textContent = fmt(aa.angle, 2);
   $('axis').textContent = '(' + aa.axis.map((a) => fmt(a, 3)).join(', ') + ')';
   $('position').textContent = '(' + s.pose.p.map((a) => fmt(a * 1e3, 2)).join(', ') + ')';
+  drawPose3d(s.pose.q, s.pose.p, s.truth);
   const c = s.counters;
   $('counters').textContent = `cycles sent ${c.cycles_sent}, CAN send failures ${c.can_send_failures}, ` +
     `CAN tx dropped ${c.can_tx_dropped}, commands ${c.commands} (${c.rejected_commands} rejected)`;
@@ -265,4 +337,5 @@ refreshImages();
 setInterval(redrawPlots, 100);
 for (const id of ['show-shear', 'show-contact', 'show-fz'])
   $(id).addEventListener('change', () => PADS.forEach(drawPad));
-window.tacse3 = { series, last: () => last, plots: () => plots.length };  // for the browser test
+window.tacse3 = { series, last: () => last, plots: () => plots.length, pose3d: () => drawnPose,
+                   poseAxes };  // for the browser test

@@ -4,9 +4,9 @@
 
 Starts tacse3d --board BOARD --http 127.0.0.1:PORT with the board's [viewer] controls on, loads
 the page and checks that the stream is live, the plots move, both pad canvases show an image (not
-blank), the left pad reads OK, the pose readout matches /api/state on the same cycle, and that the
-tare button is answered with an ACK shown on the page and restarts the pose. Saves a screenshot
-to --screenshot.
+blank), the left pad reads OK, the pose readout and the 3D view's end points match /api/state on
+the same cycle, and that the tare button is answered with an ACK shown on the page and restarts
+the pose. Saves a screenshot to --screenshot.
 Exit 77 (ctest: skipped) with a message when Chromium, its driver or selenium is missing.
 """
 import argparse
@@ -19,6 +19,8 @@ import subprocess
 import sys
 import time
 import urllib.request
+
+from pose3d_check import check_pose3d
 
 SKIP = 77
 
@@ -50,6 +52,17 @@ for (let i = 0; i < d.length; i += 4) {
 }
 const m = s / n;
 return Math.sqrt(Math.max(0, s2 / n - m * m));
+"""
+
+
+# Whether the 3D view's canvas has a strongly red pixel (the x axes).
+CANVAS_HAS_RED = """
+const c = document.getElementById('pose3d');
+const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+for (let i = 0; i < d.length; i += 4) {
+  if (d[i + 3] > 200 && d[i] > 180 && d[i + 1] < 90 && d[i + 2] < 90) return true;
+}
+return false;
 """
 
 
@@ -135,15 +148,20 @@ def main():
         # The pose readout matches /api/state: wait for a moment when the page shows the cycle the
         # API serves (both change every 50 ms), then compare the angle shown with the API's.
         def same_cycle():
-            cycle, shown = js("return [window.tacse3.last().cycle, "
-                              "document.getElementById('angle').textContent]")
+            cycle, shown, drawn = js("return [window.tacse3.last().cycle, "
+                                     "document.getElementById('angle').textContent, "
+                                     "window.tacse3.pose3d()]")
             api = state()
-            return (shown, api) if api and api["cycle"] == cycle else None
-        shown, api = wait_for("the page and /api/state on one cycle", same_cycle, 10)
+            return (shown, drawn, api) if api and api["cycle"] == cycle else None
+        shown, drawn, api = wait_for("the page and /api/state on one cycle", same_cycle, 10)
         w = min(1.0, abs(api["pose"]["q"][0]))
         angle = 2 * math.degrees(math.acos(w))
         assert abs(float(shown) - angle) < 0.006, f"angle shown {shown}, /api/state {angle:.4f}"
         print(f"cycle {api['cycle']}: angle shown {shown} deg, /api/state {angle:.4f} deg")
+        # The 3D view draws that pose: its end points are /api/state's quaternion and position.
+        worst = check_pose3d(drawn, api["pose"]["q"], api["pose"]["p"])
+        print(f"3D view: end points within {worst:.2g} px of /api/state's pose")
+        assert js(CANVAS_HAS_RED), "the 3D view's canvas shows no red x axis"
 
         # Tare: the ACK on the page, and the pose restarts from identity (it has turned by then:
         # the scenario rotates 30 degrees about z).
