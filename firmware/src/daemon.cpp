@@ -802,10 +802,13 @@ int Daemon::run(bool handle_signals) {
   if (view_server_) {
     const ViewServer::Stats vs = view_server_->stats();
     view_server_.reset();
-    say(1, "viewer: %llu snapshots served, %llu streams refused (too many), %llu dropped (slow)",
+    say(1,
+        "viewer: %llu snapshots served, %llu streams refused (too many), %llu dropped (slow), "
+        "%llu connections refused (busy)",
         static_cast<unsigned long long>(vs.snapshots),
         static_cast<unsigned long long>(vs.streams_refused),
-        static_cast<unsigned long long>(vs.streams_dropped));
+        static_cast<unsigned long long>(vs.streams_dropped),
+        static_cast<unsigned long long>(vs.connections_refused));
   }
 #endif
   engine_->release_all();

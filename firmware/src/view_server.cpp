@@ -4,10 +4,13 @@
 // JPEG); the server's pool threads only hand out what was rendered, under a short lock.
 #include "tacse3/firmware/view_server.hpp"
 
+#include <fcntl.h>
 #include <httplib.h>
+#include <poll.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <turbojpeg.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
@@ -34,6 +37,8 @@ namespace {
 constexpr int kJpegQuality = 85;
 constexpr auto kSamplePoll = std::chrono::milliseconds(10);
 constexpr auto kStreamHeartbeat = std::chrono::seconds(1);
+// The longest the refuser and the listener wait for a connection before looking for a stop.
+constexpr auto kAcceptPoll = std::chrono::milliseconds(100);
 // Stack sizes (docs/performance.md, "Thread stacks"): under the daemon's mlockall(MCL_FUTURE)
 // every byte of a stack is resident. Measured high-water marks while serving the page, every
 // endpoint and an event stream: sampler (JSON, JPEG encoding) 12 KiB, listener 12 KiB, pool
@@ -41,6 +46,7 @@ constexpr auto kStreamHeartbeat = std::chrono::seconds(1);
 constexpr std::size_t kSamplerStack = 128 * 1024;
 constexpr std::size_t kListenerStack = 128 * 1024;
 constexpr std::size_t kPoolStack = 128 * 1024;
+constexpr std::size_t kRefuserStack = 64 * 1024;  // poll, accept, a fixed answer
 
 // A rendered snapshot, shared by every request that serves it.
 struct Rendered {
@@ -118,7 +124,10 @@ std::string ack_json(const protocol::Ack& a) {
 // own pool starts std::threads with the default 8 MiB stack.
 class SizedPool final : public httplib::TaskQueue {
  public:
-  SizedPool(std::size_t n, std::size_t stack_bytes) {
+  // on_full: called when the listener starts waiting for room (under the pool's lock).
+  SizedPool(std::size_t n, std::size_t max_waiting, std::size_t stack_bytes,
+            std::function<void()> on_full)
+      : max_waiting_(max_waiting), on_full_(std::move(on_full)) {
     workers_.reserve(n);
     try {
       for (std::size_t i = 0; i < n; ++i) workers_.emplace_back(stack_bytes, [this] { work(); });
@@ -129,12 +138,29 @@ class SizedPool final : public httplib::TaskQueue {
   }
   ~SizedPool() override { shutdown(); }
 
+  // Called by httplib's listener with each accepted connection. With `max_waiting` connections
+  // waiting for a worker, it holds the listener here until one is taken: the listener accepts
+  // nothing meanwhile, and the Refuser answers the rest (docs/viewer.md, "Limits").
   void enqueue(std::function<void()> fn) override {
+    std::unique_lock<std::mutex> lock(mutex_);
+    jobs_.push_back(std::move(fn));
+    cond_.notify_one();
+    if (jobs_.size() < max_waiting_) return;
+    full_.store(true);
+    on_full_();
+    room_.wait(lock, [this] { return jobs_.size() < max_waiting_ || releasing_; });
+    full_.store(false);
+  }
+
+  // True while the listener waits for room (the Refuser's cue).
+  bool full() const noexcept { return full_.load(); }
+  // Lets a listener held in enqueue() go: the server is stopping.
+  void release() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      jobs_.push_back(std::move(fn));
+      releasing_ = true;
     }
-    cond_.notify_one();
+    room_.notify_all();
   }
 
   // Runs the jobs already queued, then joins every worker.
@@ -160,20 +186,44 @@ class SizedPool final : public httplib::TaskQueue {
         fn = std::move(jobs_.front());
         jobs_.pop_front();
       }
+      room_.notify_one();
       fn();
     }
   }
 
+  const std::size_t max_waiting_;
+  const std::function<void()> on_full_;
   std::mutex mutex_;
   std::condition_variable cond_;
+  std::condition_variable room_;            // a job was taken, or release()
   std::deque<std::function<void()>> jobs_;  // guarded by mutex_
   bool stopping_ = false;                   // guarded by mutex_
-  std::vector<Thread> workers_;             // last: started once the rest exists
+  bool releasing_ = false;                  // guarded by mutex_
+  std::atomic<bool> full_{false};
+  std::vector<Thread> workers_;  // last: started once the rest exists
 };
 
 // Linux: nice is per thread, and threads inherit it from the thread that creates them.
 void lower_priority(int nice) {
   setpriority(PRIO_PROCESS, 0, nice);
+}
+
+// A connection beyond the limit: a fixed 503 sent without waiting (the socket is non-blocking),
+// then closed. What the client sent is drained first, so the close is a FIN, not a reset that
+// could discard the answer.
+void refuse_connection(int sock) {
+  static const char kBody[] =
+      "{\"error\":\"too many connections: the viewer serves a fixed number at once; retry\"}\n";
+  static const std::string kAnswer =
+      std::string("HTTP/1.1 503 Service Unavailable\r\nContent-Type: application/json\r\n") +
+      "Content-Length: " + std::to_string(sizeof(kBody) - 1) +
+      "\r\nRetry-After: 1\r\nConnection: close\r\n\r\n" + kBody;
+  (void)send(sock, kAnswer.data(), kAnswer.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
+  shutdown(sock, SHUT_WR);
+  char drain[4096];
+  for (int i = 0; i < 4 && recv(sock, drain, sizeof(drain), MSG_DONTWAIT) > 0; ++i) {
+  }
+  close(sock);
 }
 
 }  // namespace
@@ -235,8 +285,39 @@ struct ViewServer::Impl {
   std::atomic<std::uint64_t> snapshots{0};
   std::atomic<std::uint64_t> refused{0};
   std::atomic<std::uint64_t> dropped{0};
+  std::atomic<std::uint64_t> connections_refused{0};
+  std::atomic<SizedPool*> pool{nullptr};  // made by httplib's listener thread
+  int listen_fd = -1;                     // httplib's listening socket (non-blocking)
   Thread sampler;
   Thread listener;
+  Thread refuser;
+
+  // While the pool is full, accepts on the listening socket in the listener's place and answers
+  // each connection 503 at once.
+  void refuse_loop() {
+    lower_priority(config.nice);
+    for (;;) {
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        if (stopping) return;
+        const auto full = [this] {
+          const SizedPool* p = pool.load();
+          return p != nullptr && p->full();
+        };
+        if (!full()) {
+          changed.wait_for(lock, kAcceptPoll, [&] { return stopping || full(); });
+          continue;
+        }
+      }
+      pollfd pfd{listen_fd, POLLIN, 0};
+      if (poll(&pfd, 1, static_cast<int>(kAcceptPoll.count())) <= 0) continue;
+      if (!pool.load()->full()) continue;  // room again: the listener serves it
+      const int sock = accept4(listen_fd, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+      if (sock < 0) continue;  // the listener took it, or nothing was pending
+      connections_refused.fetch_add(1, std::memory_order_relaxed);
+      refuse_connection(sock);
+    }
+  }
 
   std::shared_ptr<const Rendered> current() const {
     std::lock_guard<std::mutex> lock(mutex);
@@ -443,16 +524,27 @@ std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, Vi
     }
   }
   httplib::Server& sv = impl->server;
-  const int threads = config.threads;
-  sv.new_task_queue = [threads] {
-    return new SizedPool(static_cast<std::size_t>(threads), kPoolStack);
+  Impl* p = impl.get();
+  sv.new_task_queue = [p] {
+    auto* pool = new SizedPool(static_cast<std::size_t>(p->config.threads),
+                               static_cast<std::size_t>(p->config.max_waiting), kPoolStack, [p] {
+                                 { std::lock_guard<std::mutex> lock(p->mutex); }
+                                 p->changed.notify_all();
+                               });
+    p->pool.store(pool);
+    return pool;
   };
   // SO_REUSEADDR only: a restart binds at once, but a second daemon on the same port fails
-  // (httplib's default adds SO_REUSEPORT, which would let both listen).
-  sv.set_socket_options([](socket_t sock) {
+  // (httplib's default adds SO_REUSEPORT, which would let both listen). Non-blocking, so that the
+  // refuser and the listener can both accept on it (whoever loses gets EAGAIN); the listener
+  // waits for a connection in select() first (the idle interval below).
+  sv.set_socket_options([p](socket_t sock) {
     int yes = 1;
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+    fcntl(sock, F_SETFL, fcntl(sock, F_GETFL) | O_NONBLOCK);
+    p->listen_fd = sock;
   });
+  sv.set_idle_interval(0, std::chrono::microseconds(kAcceptPoll).count());
   sv.set_keep_alive_max_count(1000);
   sv.set_keep_alive_timeout(2);
   sv.set_read_timeout(2, 0);
@@ -469,8 +561,8 @@ std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, Vi
                               : std::string("bind failed"));
     return nullptr;
   }
-  Impl* p = impl.get();
   p->sampler = Thread(kSamplerStack, [p] { p->sample_loop(); });
+  p->refuser = Thread(kRefuserStack, [p] { p->refuse_loop(); });
   p->listener = Thread(kListenerStack, [p] {
     lower_priority(p->config.nice);  // before the pool threads exist: they inherit it
     p->server.listen_after_bind();
@@ -487,6 +579,10 @@ ViewServer::~ViewServer() {
     impl_->stopping = true;
   }
   impl_->changed.notify_all();
+  // The refuser polls the listening socket: it ends before server.stop() closes it. A listener
+  // held by a full pool is let go so that it sees the stop.
+  if (impl_->refuser.joinable()) impl_->refuser.join();
+  if (SizedPool* pool = impl_->pool.load()) pool->release();
   impl_->server.stop();
   if (impl_->listener.joinable()) impl_->listener.join();
   if (impl_->sampler.joinable()) impl_->sampler.join();
@@ -497,6 +593,7 @@ ViewServer::Stats ViewServer::stats() const noexcept {
   s.snapshots = impl_->snapshots.load(std::memory_order_relaxed);
   s.streams_refused = impl_->refused.load(std::memory_order_relaxed);
   s.streams_dropped = impl_->dropped.load(std::memory_order_relaxed);
+  s.connections_refused = impl_->connections_refused.load(std::memory_order_relaxed);
   return s;
 }
 

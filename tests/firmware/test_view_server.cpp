@@ -337,6 +337,44 @@ TEST_F(ViewServerTest, StreamsEverySnapshotAndRefusesAFifthClient) {
   for (int s : streams) close(s);
 }
 
+// Two served, two waiting (one of them held by the listener): every further connection is answered
+// 503 at once, and once the idle ones are gone the endpoints answer again.
+TEST_F(ViewServerTest, ConnectionsBeyondTheLimitAreRefusedAtOnce) {
+  server_.reset();
+  config_.threads = 2;
+  config_.max_waiting = 2;
+  std::string e;
+  server_ = ViewServer::start(config_, slot_, &e);
+  ASSERT_TRUE(server_) << e;
+  publish(1);
+  std::vector<int> idle;  // connected, never send a byte: each holds its place up to 2 s
+  for (int i = 0; i < config_.threads + config_.max_waiting; ++i) {
+    idle.push_back(connect_to(port()));
+    ASSERT_GE(idle.back(), 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // accepted and placed
+  }
+  constexpr int kExtra = 5;
+  for (int i = 0; i < kExtra; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string answer = exchange(port(), get("/api/state"));
+    const auto ms =
+        std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0)
+            .count();
+    EXPECT_EQ(status_of(answer), 503) << answer;
+    EXPECT_NE(body_of(answer).find("too many connections"), std::string::npos) << answer;
+    EXPECT_LT(ms, 500) << "extra connection " << i << " answered after " << ms << " ms";
+  }
+  EXPECT_EQ(server_->stats().connections_refused, static_cast<std::uint64_t>(kExtra));
+  for (int s : idle) close(s);
+  bool served = false;
+  for (int i = 0; i < 40 && !served; ++i) {
+    served = status_of(exchange(port(), get("/api/state"))) == 200;
+    if (!served) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(served) << "/api/state not served within 2 s of the idle connections closing";
+  EXPECT_EQ(status_of(exchange(port(), get("/api/image/left.jpg"))), 200);
+}
+
 TEST_F(ViewServerTest, CommandsAreRefusedNamingTheBoardKeyWhenTheControlsAreOff) {
   const std::string r = exchange(port(), post("/api/command", "{\"command\":\"tare\"}"));
   EXPECT_EQ(status_of(r), 403) << r;

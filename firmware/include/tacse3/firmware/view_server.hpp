@@ -19,6 +19,7 @@ struct ViewServerConfig {
   std::filesystem::path assets;  // folder holding index.html, viewer.js, viewer.css, uPlot
   std::string info_json = "{}";  // GET /api/info (view_info_json)
   int threads = 8;               // connections served at once
+  int max_waiting = 8;           // accepted connections waiting for a thread; more get 503
   int max_streams = 4;           // /api/stream clients at once; more get 503
   int write_timeout_ms = 2000;   // a client that takes no data this long is dropped
   int nice = 10;                 // the server threads' niceness (the DSP thread is SCHED_FIFO)
@@ -49,9 +50,10 @@ class ViewServer {
   ViewServer& operator=(const ViewServer&) = delete;
 
   struct Stats {
-    std::uint64_t snapshots = 0;        // snapshots taken from the slot and rendered
-    std::uint64_t streams_refused = 0;  // /api/stream answered 503 (max_streams reached)
-    std::uint64_t streams_dropped = 0;  // streams ended because the client did not take data
+    std::uint64_t snapshots = 0;            // snapshots taken from the slot and rendered
+    std::uint64_t streams_refused = 0;      // /api/stream answered 503 (max_streams reached)
+    std::uint64_t streams_dropped = 0;      // streams ended because the client did not take data
+    std::uint64_t connections_refused = 0;  // answered 503 at once: max_waiting were waiting
   };
   Stats stats() const noexcept;
 
