@@ -4,7 +4,8 @@
 
     dsp, protocol, fileio      know nothing of the rest
     sim, config, recording     know dsp, protocol and fileio only
-    hal                        wraps the OS; may use the layers above
+    hal, viewer                hal wraps the OS; viewer (the web view) may use hal and the
+                               layers above
     firmware, tools            wire everything together (neither includes the other)
 
 The fixed-point dsp path also stays pure: it may include only the standard and Eigen headers in
@@ -27,6 +28,7 @@ PREFIX_MODULE = {
     "config": "config",
     "recording": "recording",
     "hal": "hal",
+    "viewer": "viewer",
     "firmware": "firmware",
     "tools": "tools",
     "version.hpp": "version",  # generated from the CMake project version (cmake/version.hpp.in)
@@ -44,8 +46,9 @@ ALLOWED = {
     "config": MIDDLE - {"sim", "recording"},
     "recording": MIDDLE - {"sim", "config"},
     "hal": MIDDLE | {"hal"},
-    "firmware": MIDDLE | {"hal", "firmware", "version"},
-    "tools": MIDDLE | {"hal", "tools", "dsp_ref", "version"},
+    "viewer": MIDDLE | {"hal", "viewer"},
+    "firmware": MIDDLE | {"hal", "viewer", "firmware", "version"},
+    "tools": MIDDLE | {"hal", "viewer", "tools", "dsp_ref", "version"},
 }
 
 DSP_STD_ALLOWED = {

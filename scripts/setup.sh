@@ -28,7 +28,7 @@ PACKAGES=(
   libcairo2-dev
   # tacse3d --http, the live viewer: the HTTP server (docs/viewer.md says why this one)
   libcpp-httplib-dev
-  # its browser test (tests/firmware/viewer): headless Chromium driven by selenium
+  # its browser tests (tests/viewer): headless Chromium driven by selenium
   chromium chromium-driver python3-selenium
   # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks,
   # help2man for the manual pages made from each program's --help

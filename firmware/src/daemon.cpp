@@ -10,10 +10,10 @@
 
 #include "tacse3/dsp/se3.hpp"
 #include "tacse3/firmware/system.hpp"
-#include "tacse3/firmware/thread.hpp"
+#include "tacse3/hal/thread.hpp"
 #if TACSE3_HAVE_VIEWER
-#include "tacse3/firmware/view_json.hpp"
-#include "tacse3/firmware/view_server.hpp"
+#include "tacse3/viewer/view_json.hpp"
+#include "tacse3/viewer/view_server.hpp"
 #else
 namespace tacse3::firmware {
 class ViewServer {};  // --http is not built in; the member stays null
@@ -374,20 +374,20 @@ bool Daemon::start_viewer(std::string* error) {
   const std::string what = from_cli ? std::string("--http ").append(text)
                                     : board_.origin + ": [viewer] listen \"" + text + "\"";
 #if TACSE3_HAVE_VIEWER
-  ViewServerConfig vc;
+  viewer::ViewServerConfig vc;
   std::string e;
   if (!config::parse_listen_address(text, &vc.listen, &e)) {
     *error = what + ": " + e;
     return false;
   }
-  vc.assets = find_viewer_assets(config::executable_dir());
+  vc.assets = viewer::find_viewer_assets(config::executable_dir());
   if (vc.assets.empty()) {
     *error = what + ": the viewer's page is not installed (" +
              (config::executable_dir() / ".." / "share" / "tacse3" / "viewer").string() +
              "/index.html is missing; reinstall the package or build tacse3_viewer_assets)";
     return false;
   }
-  ViewInfo info;
+  viewer::ViewInfo info;
   info.version = std::to_string(TACSE3_VERSION_MAJOR) + "." + std::to_string(TACSE3_VERSION_MINOR) +
                  "." + std::to_string(TACSE3_VERSION_PATCH);
   info.board = board_.name;
@@ -406,7 +406,7 @@ bool Daemon::start_viewer(std::string* error) {
   vc.endpoint.node_id = static_cast<std::uint8_t>(board_.can.node_id);
   vc.endpoint.layout.mode =
       board_.can.extended_ids ? protocol::IdMode::kExtended : protocol::IdMode::kStandard;
-  vc.info_json = view_info_json(info);
+  vc.info_json = viewer::view_info_json(info);
   view_slot_ = std::make_unique<ViewSlot>();
   view_server_ = ViewServer::start(vc, *view_slot_, &e);
   if (!view_server_) {
@@ -769,7 +769,7 @@ int Daemon::run(bool handle_signals) {
   // The DSP thread first: its real-time setup (mlockall, stack prefault) can take a while, and
   // frames that arrive before it runs would overflow the capture rings (a replayed recording
   // would lose its first frames, which hold the reference). Cameras start once it is looping.
-  Thread dsp(kDspStack, [this] { dsp_loop(); });
+  hal::Thread dsp(kDspStack, [this] { dsp_loop(); });
   for (int i = 0; i < 2000 && !dsp_ready_.load(std::memory_order_acquire); ++i) sleep_ns(1'000'000);
   for (std::size_t s = 0; s < 2; ++s) {
     if (!cameras_[s]) continue;
@@ -781,11 +781,11 @@ int Daemon::run(bool handle_signals) {
       return 1;
     }
   }
-  std::array<Thread, 2> capture;
+  std::array<hal::Thread, 2> capture;
   for (std::size_t s = 0; s < 2; ++s) {
-    if (cameras_[s]) capture[s] = Thread(kCaptureStack, [this, s] { capture_loop(s); });
+    if (cameras_[s]) capture[s] = hal::Thread(kCaptureStack, [this, s] { capture_loop(s); });
   }
-  Thread rx(kRxStack, [this] { rx_loop(); });
+  hal::Thread rx(kRxStack, [this] { rx_loop(); });
 
   while (!stop_.load(std::memory_order_acquire)) {
     gpio_controller_->poll(5);  // also the housekeeping tick's sleep

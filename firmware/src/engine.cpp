@@ -431,7 +431,7 @@ void Engine::send_status_group() noexcept {
   for (std::size_t s = 0; s < 2; ++s) {
     const auto& p = pipeline_.sensor(static_cast<dsp::SensorSlot>(s));
     const bool present = have_result_ && state_.health[s] == SensorHealth::kOk;
-    const double area = present ? contact_area_m2(p) : kNaN;
+    const double area = present ? viewer::contact_area_m2(p) : kNaN;
     const double conf =
         present ? static_cast<double>(result_.sensors[s].tracked_points) / dsp::kGridCount : kNaN;
     (s == 0 ? g.contact.area_left_m2 : g.contact.area_right_m2) = area;
@@ -612,7 +612,7 @@ void Engine::publish_view(std::int64_t now_ns) noexcept {
         shared_.sensors[s].camera_drops.load(std::memory_order_relaxed) + pairing_drops_[s];
   }
   view_->publish();
-  next_view_ns_ = now_ns + kViewPeriodNs;
+  next_view_ns_ = now_ns + viewer::kViewPeriodNs;
 }
 
 }  // namespace tacse3::firmware

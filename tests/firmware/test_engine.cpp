@@ -509,7 +509,7 @@ TEST_F(EngineTest, ViewSnapshotCarriesTheLastCycle) {
   const double n = v.q[0] * v.q[0] + v.q[1] * v.q[1] + v.q[2] * v.q[2] + v.q[3] * v.q[3];
   EXPECT_NEAR(n, 1.0, 1e-9);
   EXPECT_GE(v.dsp_us, 0);
-  for (const ViewPad& pad : v.pads) {
+  for (const viewer::ViewPad& pad : v.pads) {
     EXPECT_TRUE(pad.configured);
     EXPECT_TRUE(pad.present);
     int lo = 255, hi = 0;

@@ -42,6 +42,10 @@ cases = [
     ("firmware/src/i.cpp", '#include "tacse3/tools/replay.hpp"\n', 'firmware/ may not include'),
     ("tools/x/j.cpp", '#include "tacse3/firmware/daemon.hpp"\n', 'tools/ may not include'),
     ("tools/x/k.cpp", '#include "tacse3/nonsense/a.hpp"\n', "unknown module"),
+    ("viewer/src/l.cpp", '#include "tacse3/firmware/engine.hpp"\n', 'viewer/ may not include'),
+    ("viewer/src/m.cpp", '#include "tacse3/tools/replay.hpp"\n', 'viewer/ may not include'),
+    ("hal/can/src/n.cpp", '#include "tacse3/viewer/view_server.hpp"\n', 'hal/ may not include'),
+    ("recording/src/o.cpp", '#include "tacse3/viewer/view_json.hpp"\n', 'recording/ may not include'),
 ]
 with tempfile.TemporaryDirectory() as tmp:
     tree = pathlib.Path(tmp)
@@ -49,6 +53,9 @@ with tempfile.TemporaryDirectory() as tmp:
           '#include "tacse3/sim/pad.hpp"\n#include "tacse3/recording/recording.hpp"\n#include <vector>\n')
     write(tree, "dsp/reference/src/ok.cpp", '#include "tacse3/dsp_ref/x.hpp"\n#include <vector>\n')
     write(tree, "config/src/ok.cpp", '#include "tacse3/fileio/file_io.hpp"\n#include "tacse3/dsp/x.hpp"\n')
+    write(tree, "viewer/src/ok.cpp", '#include "tacse3/hal/thread.hpp"\n#include "tacse3/dsp/x.hpp"\n')
+    write(tree, "firmware/src/ok.cpp", '#include "tacse3/viewer/view_server.hpp"\n')
+    write(tree, "tools/x/ok.cpp", '#include "tacse3/viewer/view_server.hpp"\n')
     clean = run(tree)
     if clean.returncode != 0:
         failures.append("a clean tree was refused:\n" + clean.stdout)

@@ -26,11 +26,15 @@ class GpioBackend;
 class GpioController;
 }  // namespace tacse3::hal
 
+namespace tacse3::viewer {
+class ViewServer;
+}  // namespace tacse3::viewer
+
 namespace tacse3::firmware {
 
 class FrameRecorder;
 struct RecorderConfig;
-class ViewServer;
+using viewer::ViewServer;
 
 // Where the calibration came from: built-in defaults or a file (reloaded on SIGHUP).
 struct CalibrationSource {

@@ -9,17 +9,17 @@
 #include <memory>
 
 #include "tacse3/dsp/pipeline.hpp"
-#include "tacse3/firmware/command_mailbox.hpp"
 #include "tacse3/firmware/health.hpp"
 #include "tacse3/firmware/latency.hpp"
 #include "tacse3/firmware/pairing.hpp"
 #include "tacse3/firmware/recording_mailbox.hpp"
-#include "tacse3/firmware/view_snapshot.hpp"
+#include "tacse3/firmware/view_fill.hpp"
 #include "tacse3/hal/camera.hpp"
 #include "tacse3/hal/camera/spsc_ring.hpp"
 #include "tacse3/hal/can/channel.hpp"
 #include "tacse3/protocol/codec.hpp"
 #include "tacse3/protocol/commands.hpp"
+#include "tacse3/viewer/command_mailbox.hpp"
 
 namespace tacse3::firmware {
 
@@ -30,6 +30,7 @@ class FrameRecorder;
 using FrameRing = hal::SpscRing<hal::Frame, 8>;
 // RX thread / housekeeping -> DSP thread: validated commands (or NACK reasons) to answer.
 using CommandRing = hal::SpscRing<protocol::CommandResult, 16>;
+using viewer::CommandMailbox;
 
 // State shared between the threads: plain atomics, written by one side, read by the other.
 struct SharedState {

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: the live viewer's HTTP server. Two kinds of threads, all at a lower priority
+// tacse3 viewer: the live viewer's HTTP server. Two kinds of threads, all at a lower priority
 // than the DSP thread: one sampler takes each snapshot from the slot and renders it once (JSON,
 // JPEG); the server's pool threads only hand out what was rendered, under a short lock.
-#include "tacse3/firmware/view_server.hpp"
+#include "tacse3/viewer/view_server.hpp"
 
 #include <fcntl.h>
 #include <httplib.h>
@@ -26,11 +26,13 @@
 #include <thread>
 #include <vector>
 
-#include "tacse3/firmware/thread.hpp"
-#include "tacse3/firmware/view_json.hpp"
+#include "tacse3/hal/thread.hpp"
 #include "tacse3/protocol/commands.hpp"
+#include "tacse3/viewer/view_json.hpp"
 
-namespace tacse3::firmware {
+namespace tacse3::viewer {
+
+using hal::Thread;
 
 namespace {
 
@@ -597,4 +599,4 @@ ViewServer::Stats ViewServer::stats() const noexcept {
   return s;
 }
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::viewer

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: a joinable thread with an explicit stack size.
+// tacse3 hal: a joinable thread with an explicit stack size.
 #pragma once
 
 #include <pthread.h>
@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <functional>
 
-namespace tacse3::firmware {
+namespace tacse3::hal {
 
 // std::thread with the stack size as a required argument (std::thread cannot set one, and the
 // default, RLIMIT_STACK, is 8 MiB: with mlockall(MCL_FUTURE) every byte of it is resident).
@@ -37,4 +37,4 @@ class Thread {
 // The stack size a running thread was created with (pthread_getattr_np), 0 if unknown.
 std::size_t stack_size_of(pthread_t thread) noexcept;
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::hal

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: a wait-free single-writer, single-reader slot for the latest value of a
+// tacse3 viewer: a wait-free single-writer, single-reader slot for the latest value of a
 // trivially copyable struct (a triple buffer). The DSP thread writes; the viewer thread reads.
 #pragma once
 
@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <type_traits>
 
-namespace tacse3::firmware {
+namespace tacse3::viewer {
 
 // Three buffers: the writer owns one (back), the reader owns one (front), the third (middle)
 // holds the latest published value. publish() and take() each swap their own buffer with the
@@ -53,4 +53,4 @@ class SnapshotSlot {
   alignas(64) std::uint8_t front_ = 2;  // reader only
 };
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::viewer

@@ -1,17 +1,19 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: the live viewer's per-pad copy of the pipeline's last fields.
-#include "tacse3/firmware/view_snapshot.hpp"
+// tacse3 viewer: a view's per-pad copy of the pipeline's last fields.
+#include "tacse3/viewer/view_snapshot.hpp"
 
 #include <algorithm>
 
-namespace tacse3::firmware {
+namespace tacse3::viewer {
 
 namespace {
 
 constexpr float kQ16 = 1.0f / static_cast<float>(1 << dsp::kFieldFrac);
 
-void fill_pad(const dsp::SensorPipeline& p, const dsp::SensorResult& r, bool present,
-              ViewPad* out) noexcept {
+}  // namespace
+
+void fill_view_pad(const dsp::SensorPipeline& p, const dsp::SensorResult& r, bool present,
+                   ViewPad* out) noexcept {
   const dsp::SensorFields& f = p.fields();
   out->present = present;
   out->contact = present && f.contact.count > 0;
@@ -29,8 +31,6 @@ void fill_pad(const dsp::SensorPipeline& p, const dsp::SensorResult& r, bool pre
   }
 }
 
-}  // namespace
-
 double contact_area_m2(const dsp::SensorPipeline& p) noexcept {
   const auto& cal = p.calibration();
   const double cell_m =
@@ -38,16 +38,4 @@ double contact_area_m2(const dsp::SensorPipeline& p) noexcept {
   return static_cast<double>(p.fields().contact.count) * cell_m * cell_m * cal.pixel_aspect_y;
 }
 
-void fill_view_pads(const dsp::DualPipeline& pipeline, const dsp::DualResult& result,
-                    const StateOutput& state, std::array<bool, 2> configured,
-                    ViewSnapshot* out) noexcept {
-  for (std::size_t s = 0; s < 2; ++s) {
-    ViewPad& pad = out->pads[s];
-    pad.configured = configured[s];
-    pad.health = static_cast<std::uint8_t>(state.health[s]);
-    fill_pad(pipeline.sensor(static_cast<dsp::SensorSlot>(s)), result.sensors[s], result.present[s],
-             &pad);
-  }
-}
-
-}  // namespace tacse3::firmware
+}  // namespace tacse3::viewer

@@ -1,16 +1,16 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: JSON for the live viewer. A fixed schema of numbers, booleans and a few known
+// tacse3 viewer: JSON for the live viewer. A fixed schema of numbers, booleans and a few known
 // strings, so it is written directly, each number at the precision it needs: the fields go out at
 // four digits (about 70 kB per snapshot), where nlohmann::json (which parses the command
 // bodies) prints every double in full. Non-finite numbers become null (JSON has no NaN).
-#include "tacse3/firmware/view_json.hpp"
+#include "tacse3/viewer/view_json.hpp"
 
 #include <cmath>
 #include <cstdio>
 
 #include "tacse3/protocol/types.hpp"
 
-namespace tacse3::firmware {
+namespace tacse3::viewer {
 
 namespace {
 
@@ -187,4 +187,4 @@ std::string view_fields_json(const ViewSnapshot& v) {
   return s;
 }
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::viewer

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: a joinable thread with an explicit stack size.
-#include "tacse3/firmware/thread.hpp"
+// tacse3 hal: a joinable thread with an explicit stack size.
+#include "tacse3/hal/thread.hpp"
 
 #include <unistd.h>
 
@@ -10,7 +10,7 @@
 #include <system_error>
 #include <utility>
 
-namespace tacse3::firmware {
+namespace tacse3::hal {
 
 namespace {
 
@@ -76,4 +76,4 @@ std::size_t stack_size_of(pthread_t thread) noexcept {
   return size;
 }
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::hal

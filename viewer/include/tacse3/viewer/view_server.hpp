@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: the live viewer's HTTP server (cpp-httplib): the page, /api/state,
+// tacse3 viewer: the live viewer's HTTP server (cpp-httplib): the page, /api/state,
 // /api/stream (Server-Sent Events), /api/fields and the pads' JPEG images (docs/viewer.md).
 #pragma once
 
@@ -9,10 +9,10 @@
 #include <string>
 
 #include "tacse3/config/listen_address.hpp"
-#include "tacse3/firmware/command_mailbox.hpp"
-#include "tacse3/firmware/view_snapshot.hpp"
+#include "tacse3/viewer/command_mailbox.hpp"
+#include "tacse3/viewer/view_snapshot.hpp"
 
-namespace tacse3::firmware {
+namespace tacse3::viewer {
 
 struct ViewServerConfig {
   config::ListenAddress listen;
@@ -64,4 +64,4 @@ class ViewServer {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::viewer

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// firmware::Thread: the running thread has the stack size it was created with.
+// hal::Thread: the running thread has the stack size it was created with.
 #include <gtest/gtest.h>
 #include <pthread.h>
 #include <unistd.h>
@@ -9,9 +9,9 @@
 #include <climits>
 #include <cstddef>
 
-#include "tacse3/firmware/thread.hpp"
+#include "tacse3/hal/thread.hpp"
 
-namespace tacse3::firmware {
+namespace tacse3::hal {
 namespace {
 
 std::size_t stack_seen_by(std::size_t requested) {
@@ -75,4 +75,4 @@ TEST(Thread, MovesAndJoinsLikeStdThread) {
 }
 
 }  // namespace
-}  // namespace tacse3::firmware
+}  // namespace tacse3::hal

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: the viewer's controls -> DSP thread: one validated command at a time, and its
+// tacse3 viewer: the viewer's controls -> DSP thread: one validated command at a time, and its
 // ACK/NACK back to the HTTP request that sent it (docs/viewer.md, POST /api/command).
 #pragma once
 
@@ -7,7 +7,7 @@
 
 #include "tacse3/protocol/commands.hpp"
 
-namespace tacse3::firmware {
+namespace tacse3::viewer {
 
 // A single slot, lock-free. The web side holds at most one command in flight (the server
 // serialises its requests), so the DSP thread never waits and a CAN ACK never goes to the wrong
@@ -48,4 +48,4 @@ class CommandMailbox {
   protocol::Ack ack_{};
 };
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::viewer

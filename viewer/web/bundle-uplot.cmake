@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
-# tacse3 viewer: `npm ci` of firmware/web/package-lock.json in a build folder, then copies uPlot's
-# browser build into the page's folder (cmake -P, from firmware/CMakeLists.txt). A failure stops
+# tacse3 viewer: `npm ci` of viewer/web/package-lock.json in a build folder, then copies uPlot's
+# browser build into the page's folder (cmake -P, from viewer/CMakeLists.txt). A failure stops
 # the build with what to do: the page must not ship with plots silently missing.
 # Inputs: NPM, WEB (source folder), WORK (npm folder), OUT (page folder).
 file(MAKE_DIRECTORY "${WORK}")

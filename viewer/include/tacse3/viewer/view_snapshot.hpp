@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: what the DSP thread shows the live viewer: one fixed-size copy of a cycle's
-// scalars, the per-pad grid fields and the working luma image (docs/viewer.md).
+// tacse3 viewer: what a view shows of one cycle: one fixed-size copy of its scalars, the per-pad
+// grid fields and the working luma image (docs/viewer.md). tacse3d's DSP thread fills one at
+// most every kViewPeriodNs; tacse3-replay --view fills one per frame.
 #pragma once
 
 #include <array>
@@ -8,10 +9,9 @@
 
 #include "tacse3/dsp/geometry.hpp"
 #include "tacse3/dsp/pipeline.hpp"
-#include "tacse3/firmware/health.hpp"
-#include "tacse3/firmware/snapshot_slot.hpp"
+#include "tacse3/viewer/snapshot_slot.hpp"
 
-namespace tacse3::firmware {
+namespace tacse3::viewer {
 
 // The DSP thread publishes at most once per this period (docs/viewer.md: 20 Hz).
 inline constexpr std::int64_t kViewPeriodNs = 50'000'000;
@@ -66,9 +66,9 @@ using ViewSlot = SnapshotSlot<ViewSnapshot>;
 // Contact area of one sensor: |Ω| flow-grid cells of (320 / kGridWidth) sensor pixels squared.
 double contact_area_m2(const dsp::SensorPipeline& p) noexcept;
 
-// Fills every field of *out from the pipeline's last result (bounded copy, no allocation).
-void fill_view_pads(const dsp::DualPipeline& pipeline, const dsp::DualResult& result,
-                    const StateOutput& state, std::array<bool, 2> configured,
-                    ViewSnapshot* out) noexcept;
+// Fills *out's per-cycle fields (all but configured, health, frames and dropped) from one
+// sensor's pipeline and its last result (bounded copy, no allocation).
+void fill_view_pad(const dsp::SensorPipeline& p, const dsp::SensorResult& r, bool present,
+                   ViewPad* out) noexcept;
 
-}  // namespace tacse3::firmware
+}  // namespace tacse3::viewer

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// firmware tests: the viewer's snapshot slot (triple buffer): the latest value wins, nothing is
+// viewer tests: the viewer's snapshot slot (triple buffer): the latest value wins, nothing is
 // read twice, and a reader racing a writer never sees a torn value.
 #include <gtest/gtest.h>
 
@@ -9,10 +9,10 @@
 #include <memory>
 #include <thread>
 
-#include "tacse3/firmware/snapshot_slot.hpp"
-#include "tacse3/firmware/view_snapshot.hpp"
+#include "tacse3/viewer/snapshot_slot.hpp"
+#include "tacse3/viewer/view_snapshot.hpp"
 
-using namespace tacse3::firmware;
+using namespace tacse3::viewer;
 
 namespace {
 

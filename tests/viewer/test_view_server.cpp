@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// firmware tests: the viewer's HTTP server in-process on a synthetic snapshot: the exact JSON of
+// viewer tests: the viewer's HTTP server in-process on a synthetic snapshot: the exact JSON of
 // /api/state, the answers to a table of well-formed, hostile and malformed raw requests, the
 // stream's events and its client limit.
 #include <arpa/inet.h>
@@ -20,14 +20,14 @@
 #include <vector>
 
 #include "free_port.hpp"
-#include "tacse3/firmware/view_json.hpp"
-#include "tacse3/firmware/view_server.hpp"
 #include "tacse3/protocol/commands.hpp"
 #include "tacse3/protocol/types.hpp"
+#include "tacse3/viewer/view_json.hpp"
+#include "tacse3/viewer/view_server.hpp"
 
 namespace fs = std::filesystem;
 using namespace tacse3;
-using namespace tacse3::firmware;
+using namespace tacse3::viewer;
 
 using tacse3::test::free_port;
 
