@@ -112,7 +112,7 @@ class ViewServerTest : public ::testing::Test {
     std::ofstream(assets_ / "viewer.css") << "css";
     config_.listen = {"127.0.0.1", free_port()};
     config_.assets = assets_;
-    config_.info_json = view_info_json({"0.1.0", "sim", "board.toml", "", ""});
+    config_.info_json = view_info_json({"0.1.0", "sim", "board.toml", "", "", ""});
     std::string e;
     server_ = ViewServer::start(config_, slot_, &e);
     ASSERT_TRUE(server_) << e;
@@ -225,7 +225,7 @@ TEST(ViewJson, StateIsTheDocumentedDocument) {
 
 TEST(ViewJson, InfoQuotesEveryString) {
   EXPECT_EQ(json_quote("a\"b\\c\n\x01\xc3\xa9"), "\"a\\\"b\\\\c\\u000a\\u0001\xc3\xa9\"");
-  ViewInfo info{"0.1.0", "sim", "/etc/tacse3/boards/sim \"x\"/board.toml", "", ""};
+  ViewInfo info{"0.1.0", "sim", "/etc/tacse3/boards/sim \"x\"/board.toml", "", "", ""};
   EXPECT_EQ(view_info_json(info),
             "{\"version\":\"0.1.0\",\"board\":\"sim\","
             "\"board_file\":\"/etc/tacse3/boards/sim \\\"x\\\"/board.toml\",\"calibration\":null,"
@@ -238,6 +238,67 @@ TEST(ViewJson, InfoQuotesEveryString) {
                 "\"controls\":false,\"controls_off\":\"b.toml: [viewer] controls is not true\"}"),
             std::string::npos)
       << view_info_json(info);
+}
+
+TEST(ViewJson, ARecordingsFrameCarriesItsTruthAndTheInfoNamesTheRecording) {
+  ViewSnapshot v;
+  fill(&v, 3);
+  const ViewTruth truth{{0.25, 0.5, -0.5, 0.625}, {0.001, std::nan(""), 0.0}};
+  const std::string live = view_state_json(v);
+  EXPECT_EQ(view_state_json(v, &truth),
+            live.substr(0, live.size() - 1) +
+                ",\"truth\":{\"q\":[0.25,0.5,-0.5,0.625],\"p\":[0.001,null,0]}}");
+  ViewInfo info{"0.1.0", "recording", "/tmp/rec", "", "no controls", "/tmp/rec \"2\""};
+  const std::string j = view_info_json(info);
+  EXPECT_EQ(j.substr(j.size() - 30), ",\"recording\":\"/tmp/rec \\\"2\\\"\"}") << j;
+}
+
+// A recording's three frames: each endpoint serves ?frame=N, and only the documented ones exist.
+TEST_F(ViewServerTest, ARecordingIsServedFrameByFrame) {
+  server_.reset();
+  RecordedViews views;
+  std::vector<std::string> states;
+  for (std::uint64_t i = 0; i < 3; ++i) {
+    ViewSnapshot v;
+    fill(&v, i + 1);
+    const ViewTruth truth{{1.0, 0.0, 0.0, 0.0}, {0.0, 0.0, 0.001 * static_cast<double>(i)}};
+    views.add(v, &truth);
+    states.push_back(view_state_json(v, &truth));
+  }
+  std::string e;
+  server_ = ViewServer::start(config_, std::move(views), &e);
+  ASSERT_TRUE(server_) << e;
+  for (int i = 0; i < 3; ++i) {
+    const std::string q = "?frame=" + std::to_string(i);
+    EXPECT_EQ(body_of(exchange(port(), get("/api/state" + q))), states[static_cast<size_t>(i)]);
+    const std::string image = exchange(port(), get("/api/image/left.jpg" + q));
+    EXPECT_EQ(status_of(image), 200);
+    EXPECT_NE(image.find("X-Cycle: " + std::to_string(i + 1) + "\r\n"), std::string::npos);
+    EXPECT_NE(body_of(exchange(port(), get("/api/fields" + q)))
+                  .find("{\"cycle\":" + std::to_string(i + 1) + ","),
+              std::string::npos);
+  }
+  EXPECT_EQ(body_of(exchange(port(), get("/api/frames"))),
+            "{\"frames\":3,\"states\":[" + states[0] + "," + states[1] + "," + states[2] + "]}");
+  const std::string none = exchange(port(), get("/api/state"));
+  EXPECT_EQ(status_of(none), 400);
+  EXPECT_EQ(body_of(none), "{\"error\":\"give the frame: ?frame=N, N in 0..2\"}\n");
+  for (const char* bad : {"?frame=-1", "?frame=1x", "?frame=", "?frame=%2B1"})
+    EXPECT_EQ(status_of(exchange(port(), get(std::string("/api/fields") + bad))), 400) << bad;
+  const std::string past = exchange(port(), get("/api/image/left.jpg?frame=3"));
+  EXPECT_EQ(status_of(past), 404);
+  EXPECT_EQ(body_of(past), "{\"error\":\"frame 3 is not in the recording (0..2)\"}\n");
+  EXPECT_EQ(status_of(exchange(port(), get("/api/image/right.jpg?frame=0"))), 404);
+  EXPECT_EQ(status_of(exchange(port(), get("/api/stream"))), 404);
+  EXPECT_EQ(status_of(exchange(port(), post("/api/command", "{\"command\":\"tare\"}"))), 404);
+  EXPECT_EQ(status_of(exchange(port(), get("/"))), 200);
+}
+
+TEST_F(ViewServerTest, AnEmptyRecordingIsRefused) {
+  server_.reset();
+  std::string e;
+  EXPECT_FALSE(ViewServer::start(config_, RecordedViews{}, &e));
+  EXPECT_EQ(e, "the recording has no frame to show");
 }
 
 TEST_F(ViewServerTest, NothingButTheDocumentedEndpoints) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "replay_view.hpp"
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/fileio/file_io.hpp"
 #include "tacse3/tools/can_log.hpp"
@@ -174,6 +175,16 @@ int run(int argc, char** argv) {
           },
           "FILE.svg|FILE.png"));
   app.add_flag("-q,--quiet", quiet, "no progress bar and no summary");
+  std::string view;
+  tacse3::config::ListenAddress view_at;
+  app.add_option("--view", view,
+                 "then serve the recording's web view on [ADDR:]PORT until Ctrl-C (docs/viewer.md)")
+      ->check(CLI::Validator(
+          [&view_at](std::string& text) {
+            std::string e;
+            return tt::ReplayView::parse(text, &view_at, &e) ? std::string() : e;
+          },
+          "[ADDR:]PORT"));
   if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;
 
   tt::ReplayOptions opt;
@@ -260,6 +271,23 @@ int run(int argc, char** argv) {
   tt::ProgressBar bar("tacse3-replay", static_cast<std::int64_t>(info.frame_count()),
                       !quiet && tt::stderr_is_tty());
   sinks.progress = &bar;
+  std::unique_ptr<tt::ReplayView> viewer;
+  if (!view.empty()) {
+    if (const char* why = tt::ReplayView::unavailable()) return fail("--view: " + std::string(why));
+    viewer = std::make_unique<tt::ReplayView>(info, opt.calibration.fitted);
+    sinks.on_frame = [viewer = viewer.get(), log = sinks.on_frame](
+                         std::size_t i, const tt::FrameResult& r, const tt::Replayer& engine) {
+      if (log) log(i, r, engine);
+      viewer->add(i, r, engine);
+    };
+  }
+  // After the run and its summary: --view serves until Ctrl-C.
+  const auto finish = [&] {
+    if (!viewer) return 0;
+    std::fflush(stdout);
+    const std::string e = viewer->serve(view_at, cal_text);
+    return e.empty() ? 0 : fail("--view " + view + ": " + e);
+  };
 
   const tt::ReplayRun run = tt::run_replay(*source, opt, sinks);
   bar.finish();
@@ -282,7 +310,7 @@ int run(int argc, char** argv) {
   }
   csv_guard.keep = true;
   slip_guard.keep = true;
-  if (quiet) return 0;
+  if (quiet) return finish();
 
   const char* used =
       setup.use[0] && setup.use[1] ? "left+right" : (setup.use[0] ? "left" : "right");
@@ -329,7 +357,7 @@ int run(int argc, char** argv) {
                  "  slip detector: not scored (the pipeline reports no per-frame stick/slip "
                  "decision yet)\n");
   }
-  return 0;
+  return finish();
 }
 
 }  // namespace

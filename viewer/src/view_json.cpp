@@ -83,7 +83,7 @@ void pad_fields(std::string& s, const ViewPad& p) {
 
 }  // namespace
 
-std::string view_state_json(const ViewSnapshot& v) {
+std::string view_state_json(const ViewSnapshot& v, const ViewTruth* truth) {
   std::string s;
   s.reserve(1024);
   s += "{\"cycle\":";
@@ -126,7 +126,15 @@ std::string view_state_json(const ViewSnapshot& v) {
   pad_state(s, v.pads[0]);
   s += ",\"right\":";
   pad_state(s, v.pads[1]);
-  s += "}}";
+  s += '}';
+  if (truth != nullptr) {
+    s += ",\"truth\":{\"q\":";
+    array(s, truth->q);
+    s += ",\"p\":";
+    array(s, truth->p);
+    s += '}';
+  }
+  s += '}';
   return s;
 }
 
@@ -162,6 +170,10 @@ std::string view_info_json(const ViewInfo& info) {
   s += info.controls_off.empty() ? "true" : "false";
   s += ",\"controls_off\":";
   s += info.controls_off.empty() ? std::string("null") : json_quote(info.controls_off);
+  if (!info.recording.empty()) {
+    s += ",\"recording\":";
+    s += json_quote(info.recording);
+  }
   s += '}';
   return s;
 }

@@ -50,6 +50,8 @@ constexpr std::size_t kListenerStack = 128 * 1024;
 constexpr std::size_t kPoolStack = 128 * 1024;
 constexpr std::size_t kRefuserStack = 64 * 1024;  // poll, accept, a fixed answer
 
+}  // namespace
+
 // A rendered snapshot, shared by every request that serves it.
 struct Rendered {
   std::uint64_t seq = 0;
@@ -57,6 +59,8 @@ struct Rendered {
   std::string state_json;
   std::array<std::string, 2> jpeg;  // empty: the pad is not configured
 };
+
+namespace {
 
 struct Asset {
   std::string body;
@@ -97,6 +101,19 @@ std::string encode_jpeg(tjhandle tj, const std::array<std::uint8_t, dsp::kWorkPi
   }
   tjFree(buf);
   return out;
+}
+
+// The snapshot's JSON and its pads' JPEGs, made once.
+std::shared_ptr<const Rendered> render(tjhandle tj, std::shared_ptr<const ViewSnapshot> snap,
+                                       std::uint64_t seq, const ViewTruth* truth) {
+  auto r = std::make_shared<Rendered>();
+  r->seq = seq;
+  r->state_json = view_state_json(*snap, truth);
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (snap->pads[s].configured && tj != nullptr) r->jpeg[s] = encode_jpeg(tj, snap->pads[s].luma);
+  }
+  r->snapshot = std::move(snap);
+  return r;
 }
 
 std::string error_json(const std::string& message) {
@@ -273,10 +290,12 @@ bool parse_web_command(const std::string& body, protocol::Command* command, std:
 }
 
 struct ViewServer::Impl {
-  Impl(const ViewServerConfig& c, ViewSlot& s) : config(c), slot(s) {}
+  Impl(const ViewServerConfig& c, ViewSlot* s) : config(c), slot(s) {}
 
   ViewServerConfig config;
-  ViewSlot& slot;
+  ViewSlot* slot;           // live; null: a recording
+  RecordedViews recorded;   // a recording's frames (empty when live)
+  std::string frames_json;  // GET /api/frames of a recording
   httplib::Server server;
   std::map<std::string, Asset> assets;
   mutable std::mutex mutex;
@@ -326,6 +345,11 @@ struct ViewServer::Impl {
     return latest;
   }
 
+  // What a request asks for: live, the latest snapshot (null before the first); a recording,
+  // frame ?frame=N (null with *status and *error set when N is missing or out of range).
+  std::shared_ptr<const Rendered> pick(const httplib::Request& req, int* status,
+                                       std::string* error) const;
+
   void sample_loop() {
     lower_priority(config.nice);
     tjhandle tj = tjInitCompress();
@@ -333,16 +357,8 @@ struct ViewServer::Impl {
     std::unique_lock<std::mutex> lock(mutex);
     while (!stopping) {
       lock.unlock();
-      if (slot.take()) {
-        auto r = std::make_shared<Rendered>();
-        auto snap = std::make_shared<ViewSnapshot>(slot.front());
-        r->seq = ++seq;
-        r->state_json = view_state_json(*snap);
-        for (std::size_t s = 0; s < 2; ++s) {
-          if (snap->pads[s].configured && tj != nullptr)
-            r->jpeg[s] = encode_jpeg(tj, snap->pads[s].luma);
-        }
-        r->snapshot = std::move(snap);
+      if (slot->take()) {
+        auto r = render(tj, std::make_shared<ViewSnapshot>(slot->front()), ++seq, nullptr);
         snapshots.fetch_add(1, std::memory_order_relaxed);
         lock.lock();
         latest = std::move(r);
@@ -391,6 +407,8 @@ struct ViewServer::Impl {
 
   void command(const httplib::Request& req, httplib::Response& res);
   void routes();
+  void data_routes();
+  void live_routes();
 };
 
 // POST /api/command: built as this node's CAN Command frame and validated by validate_command,
@@ -434,13 +452,37 @@ void ViewServer::Impl::command(const httplib::Request& req, httplib::Response& r
   res.set_content(ack_json(ack), "application/json");
 }
 
+std::shared_ptr<const Rendered> ViewServer::Impl::pick(const httplib::Request& req, int* status,
+                                                       std::string* error) const {
+  if (slot != nullptr) {
+    auto r = current();
+    if (!r) {
+      *status = 503;
+      *error = "no cycle yet";
+    }
+    return r;
+  }
+  const std::string n = req.get_param_value("frame");
+  const std::string range = "0.." + std::to_string(recorded.size() - 1);
+  char* end = nullptr;
+  const unsigned long long i = std::strtoull(n.c_str(), &end, 10);
+  if (n.empty() || n[0] < '0' || n[0] > '9' || *end != '\0') {
+    *status = 400;
+    *error = "give the frame: ?frame=N, N in " + range;
+    return nullptr;
+  }
+  if (i >= recorded.size()) {
+    *status = 404;
+    *error = "frame " + n + " is not in the recording (" + range + ")";
+    return nullptr;
+  }
+  return recorded.at(static_cast<std::size_t>(i));
+}
+
+// The page and what does not change.
 void ViewServer::Impl::routes() {
   using httplib::Request;
   using httplib::Response;
-  const auto no_cycle = [](Response& res) {
-    res.status = 503;
-    res.set_content("{\"error\":\"no cycle yet\"}\n", "application/json");
-  };
   server.Get("/", [this](const Request&, Response& res) {
     const Asset& a = assets.at("index.html");
     res.set_content(a.body, a.mime);
@@ -458,32 +500,57 @@ void ViewServer::Impl::routes() {
   server.Get("/api/info", [this](const Request&, Response& res) {
     res.set_content(config.info_json, "application/json");
   });
-  server.Get("/api/state", [this, no_cycle](const Request&, Response& res) {
-    const auto r = current();
-    if (!r) return no_cycle(res);
-    res.set_header("Cache-Control", "no-store");
-    res.set_content(r->state_json, "application/json");
+  data_routes();
+  if (slot != nullptr) {
+    live_routes();
+  } else {
+    server.Get("/api/frames", [this](const Request&, Response& res) {
+      res.set_content(frames_json, "application/json");
+    });
+  }
+}
+
+// One snapshot's state, fields and images: the latest (live) or ?frame=N (a recording).
+void ViewServer::Impl::data_routes() {
+  using httplib::Request;
+  using httplib::Response;
+  const auto get = [this](const Request& req, Response& res) {
+    int status = 0;
+    std::string e;
+    auto r = pick(req, &status, &e);
+    if (!r) {
+      res.status = status;
+      res.set_content(error_json(e), "application/json");
+    } else {
+      res.set_header("Cache-Control", "no-store");
+    }
+    return r;
+  };
+  server.Get("/api/state", [get](const Request& req, Response& res) {
+    if (const auto r = get(req, res)) res.set_content(r->state_json, "application/json");
   });
-  server.Get("/api/fields", [this, no_cycle](const Request&, Response& res) {
-    const auto r = current();
-    if (!r) return no_cycle(res);
-    res.set_header("Cache-Control", "no-store");
-    res.set_content(view_fields_json(*r->snapshot), "application/json");
+  server.Get("/api/fields", [get](const Request& req, Response& res) {
+    if (const auto r = get(req, res))
+      res.set_content(view_fields_json(*r->snapshot), "application/json");
   });
-  server.Get(R"(/api/image/(left|right)\.jpg)",
-             [this, no_cycle](const Request& req, Response& res) {
-               const std::size_t s = req.matches[1] == "left" ? 0 : 1;
-               const auto r = current();
-               if (!r) return no_cycle(res);
-               if (r->jpeg[s].empty()) {
-                 res.status = 404;
-                 res.set_content("no such sensor on this board\n", "text/plain");
-                 return;
-               }
-               res.set_header("Cache-Control", "no-store");
-               res.set_header("X-Cycle", std::to_string(r->snapshot->cycle));
-               res.set_content(r->jpeg[s], "image/jpeg");
-             });
+  server.Get(R"(/api/image/(left|right)\.jpg)", [get](const Request& req, Response& res) {
+    const std::size_t s = req.matches[1] == "left" ? 0 : 1;
+    const auto r = get(req, res);
+    if (!r) return;
+    if (r->jpeg[s].empty()) {
+      res.status = 404;
+      res.set_content("no such sensor on this board\n", "text/plain");
+      return;
+    }
+    res.set_header("X-Cycle", std::to_string(r->snapshot->cycle));
+    res.set_content(r->jpeg[s], "image/jpeg");
+  });
+}
+
+// What only a running daemon has: the event stream and the controls.
+void ViewServer::Impl::live_routes() {
+  using httplib::Request;
+  using httplib::Response;
   server.Post("/api/command", [this](const Request& req, Response& res) { command(req, res); });
   server.Get("/api/stream", [this](const Request&, Response& res) {
     if (streams.fetch_add(1) >= config.max_streams) {
@@ -503,6 +570,43 @@ void ViewServer::Impl::routes() {
   });
 }
 
+struct RecordedViews::Frames {
+  std::vector<std::shared_ptr<const Rendered>> frames;
+  tjhandle tj = tjInitCompress();
+  ~Frames() {
+    if (tj != nullptr) tjDestroy(tj);
+  }
+};
+
+RecordedViews::RecordedViews() : frames_(std::make_unique<Frames>()) {}
+RecordedViews::~RecordedViews() = default;
+RecordedViews::RecordedViews(RecordedViews&&) noexcept = default;
+RecordedViews& RecordedViews::operator=(RecordedViews&&) noexcept = default;
+
+void RecordedViews::add(const ViewSnapshot& snapshot, const ViewTruth* truth) {
+  const std::uint64_t seq = frames_->frames.size();
+  frames_->frames.push_back(
+      render(frames_->tj, std::make_shared<ViewSnapshot>(snapshot), seq, truth));
+}
+
+std::size_t RecordedViews::size() const noexcept {
+  return frames_->frames.size();
+}
+
+const std::shared_ptr<const Rendered>& RecordedViews::at(std::size_t i) const {
+  return frames_->frames.at(i);
+}
+
+std::string RecordedViews::frames_json() const {
+  std::string s = "{\"frames\":" + std::to_string(size()) + ",\"states\":[";
+  for (std::size_t i = 0; i < size(); ++i) {
+    if (i > 0) s += ',';
+    s += frames_->frames[i]->state_json;
+  }
+  s += "]}";
+  return s;
+}
+
 std::filesystem::path find_viewer_assets(const std::filesystem::path& exe_dir) {
   const std::filesystem::path dir = exe_dir / ".." / "share" / "tacse3" / "viewer";
   std::error_code ec;
@@ -514,7 +618,23 @@ ViewServer::ViewServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, ViewSlot& slot,
                                               std::string* error) {
-  auto impl = std::make_unique<Impl>(config, slot);
+  return serve(std::make_unique<Impl>(config, &slot), error);
+}
+
+std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config,
+                                              RecordedViews recording, std::string* error) {
+  if (recording.size() == 0) {
+    *error = "the recording has no frame to show";
+    return nullptr;
+  }
+  auto impl = std::make_unique<Impl>(config, nullptr);
+  impl->recorded = std::move(recording);
+  impl->frames_json = impl->recorded.frames_json();
+  return serve(std::move(impl), error);
+}
+
+std::unique_ptr<ViewServer> ViewServer::serve(std::unique_ptr<Impl> impl, std::string* error) {
+  const ViewServerConfig& config = impl->config;
   for (const AssetName& n : kAssets) {
     std::string body;
     if (read_file(config.assets / n.name, &body)) {
@@ -563,7 +683,7 @@ std::unique_ptr<ViewServer> ViewServer::start(const ViewServerConfig& config, Vi
                               : std::string("bind failed"));
     return nullptr;
   }
-  p->sampler = Thread(kSamplerStack, [p] { p->sample_loop(); });
+  if (p->slot != nullptr) p->sampler = Thread(kSamplerStack, [p] { p->sample_loop(); });
   p->refuser = Thread(kRefuserStack, [p] { p->refuse_loop(); });
   p->listener = Thread(kListenerStack, [p] {
     lower_priority(p->config.nice);  // before the pool threads exist: they inherit it

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3d live view: reads /api/stream (Server-Sent Events), /api/fields and the pads' JPEGs
-// (docs/viewer.md) and draws them. Its only write is POST /api/command, from the control
-// buttons, which are greyed out unless the board enables the controls.
+// tacse3 web view: live (tacse3d --http) it reads /api/stream (Server-Sent Events), /api/fields
+// and the pads' JPEGs (docs/viewer.md) and draws them; its only write is POST /api/command, from
+// the control buttons, which are greyed out unless the board enables the controls. On a
+// recording (tacse3-replay --view, /api/info has "recording") it shows the frame the scrubber or
+// play picks, with the recording's truth when it has one.
 'use strict';
 
 const WINDOW_S = 10;       // rolling plots
@@ -92,7 +94,7 @@ function drawPose3d(q, p, truth) {
 
 // --- plots ---
 const series = { t: [], w: [[], [], []], v: [[], [], []], rot: [[], [], []], area: [[], []],
-                 conf: [], dsp: [], latency: [] };
+                 conf: [], dsp: [], latency: [], truth: [[], [], []] };
 const plots = [];
 function makePlot(el, title, labels, columns, unit) {
   if (typeof uPlot === 'undefined') return;
@@ -101,22 +103,31 @@ function makePlot(el, title, labels, columns, unit) {
     title, width: 460, height: 180,
     scales: { x: { time: false } },
     axes: [{ label: 's' }, { label: unit }],
-    series: [{}].concat(labels.map((l, i) => ({ label: l, stroke: colours[i % 3], width: 1.5 }))),
+    // A truth series is dashed, in its estimate's colour.
+    series: [{}].concat(labels.map((l, i) => ({ label: l, stroke: colours[i % 3], width: 1.5,
+                                                 dash: l.startsWith('truth') ? [6, 4] : [] }))),
   };
   plots.push({ plot: new uPlot(opts, [[]].concat(labels.map(() => [])), el), columns });
 }
-function setupPlots() {
+function setupPlots(withTruth) {
   if (typeof uPlot === 'undefined') { $('plots-missing').hidden = false; return; }
   makePlot($('plot-w'), 'angular twist ω', ['x', 'y', 'z'], () => series.w, 'deg/s');
   makePlot($('plot-v'), 'linear twist v', ['x', 'y', 'z'], () => series.v, 'mm/s');
-  makePlot($('plot-angles'), 'pose rotation vector', ['x', 'y', 'z'], () => series.rot, 'deg');
+  if (withTruth) {
+    makePlot($('plot-angles'), 'pose rotation vector, truth dashed',
+             ['x', 'y', 'z', 'truth x', 'truth y', 'truth z'],
+             () => series.rot.concat(series.truth), 'deg');
+  } else {
+    makePlot($('plot-angles'), 'pose rotation vector', ['x', 'y', 'z'], () => series.rot, 'deg');
+  }
   makePlot($('plot-area'), 'contact area', ['left', 'right'], () => series.area, 'mm²');
   makePlot($('plot-conf'), 'confidence', ['confidence'], () => [series.conf], '');
   makePlot($('plot-timing'), 'timing', ['dsp', 'latency'], () => [series.dsp, series.latency],
            'µs');
 }
 let t0_us = null;  // the plots' time axis: seconds since the page's first snapshot
-function record(s) {
+// Appends snapshot s to the plots' series; live, only the last WINDOW_S seconds are kept.
+function record(s, keepAll) {
   if (t0_us === null) t0_us = s.t_us;
   const t = (s.t_us - t0_us) / 1e6;
   const deg = 180 / Math.PI;
@@ -128,11 +139,15 @@ function record(s) {
     push(series.v[i], s.twist.v[i] === null ? null : s.twist.v[i] * 1e3);
     series.rot[i].push(aa.angle * aa.axis[i]);
   }
+  if (s.truth) {
+    const ta = angleAxis(s.truth.q);
+    for (let i = 0; i < 3; i++) series.truth[i].push(ta.angle * ta.axis[i]);
+  }
   PADS.forEach((p, i) => series.area[i].push(s.sensors[p].contact_area_m2 * 1e6));
   push(series.conf, s.confidence);
   series.dsp.push(s.dsp_us < 0 ? null : s.dsp_us);
   series.latency.push(s.latency_us < 0 ? null : s.latency_us);
-  // Keep the last WINDOW_S seconds.
+  if (keepAll) return;
   let drop = 0;
   while (drop < series.t.length && series.t[drop] < t - WINDOW_S) drop++;
   if (drop > 0) {
@@ -148,6 +163,10 @@ function redrawPlots() {
 // --- scalars ---
 let last = null;
 function show(s) {
+  showScalars(s);
+  record(s, false);
+}
+function showScalars(s) {
   last = s;
   const st = $('state');
   st.textContent = s.state;
@@ -163,6 +182,7 @@ function show(s) {
   $('axis').textContent = '(' + aa.axis.map((a) => fmt(a, 3)).join(', ') + ')';
   $('position').textContent = '(' + s.pose.p.map((a) => fmt(a * 1e3, 2)).join(', ') + ')';
   drawPose3d(s.pose.q, s.pose.p, s.truth);
+  $('truth-caption').hidden = !s.truth;
   const c = s.counters;
   $('counters').textContent = `cycles sent ${c.cycles_sent}, CAN send failures ${c.can_send_failures}, ` +
     `CAN tx dropped ${c.can_tx_dropped}, commands ${c.commands} (${c.rejected_commands} rejected)`;
@@ -174,7 +194,6 @@ function show(s) {
         `area ${fmt(d.contact_area_m2 * 1e6, 1)} mm²  tracked ${fmt(d.tracked_fraction * 100, 0)} %  ` +
         `frames ${d.frames} (${d.dropped} dropped)`;
   }
-  record(s);
 }
 
 // --- images and overlays ---
@@ -280,10 +299,13 @@ async function showInfo() {
   try {
     const r = await fetch('api/info');
     const i = await r.json();
-    $('info').textContent = `board ${i.board} (${i.board_file}), calibration ` +
-      `${i.calibration === null ? 'built-in defaults' : i.calibration}, tacse3d ${i.version}`;
-    setupControls(i);
-  } catch (e) { /* shown as "-" */ }
+    const cal = `calibration ${i.calibration === null ? 'built-in defaults' : i.calibration}`;
+    $('info').textContent = i.recording
+      ? `recording ${i.recording}, ${cal}, tacse3-replay ${i.version}`
+      : `board ${i.board} (${i.board_file}), ${cal}, tacse3d ${i.version}`;
+    if (!i.recording) setupControls(i);
+    return i;
+  } catch (e) { return null; /* shown as "-" */ }
 }
 
 // --- controls: each button posts one command; the daemon's ACK/NACK is shown as it came ---
@@ -330,12 +352,97 @@ async function send(body) {
   }
 }
 
-setupPlots();
-showInfo();
-connect();
-refreshImages();
-setInterval(redrawPlots, 100);
+// --- a recording: the scrubber and play pick the frame; every frame is in the plots ---
+const rec = { states: [], index: 0, shown: -1, playing: false, wall0: 0, t0: 0, asked: 0 };
+
+async function getJson(url) {
+  const r = await fetch(url, { cache: 'no-store' });
+  return r.ok ? r.json() : null;
+}
+
+async function getImage(url) {
+  const r = await fetch(url, { cache: 'no-store' });
+  return r.ok ? createImageBitmap(await r.blob()) : null;
+}
+
+// Fetches frame i's state, fields and images and shows them (unless a later frame was asked for
+// meanwhile).
+async function showFrame(i) {
+  rec.index = i;
+  const ticket = ++rec.asked;
+  $('frame').value = i;
+  const q = '?frame=' + i;
+  const [s, f] = await Promise.all([getJson('api/state' + q), getJson('api/fields' + q)]);
+  if (!s) return;
+  const imgs = await Promise.all(PADS.map((p) => (s.sensors[p].configured
+    ? getImage('api/image/' + p + '.jpg' + q) : null)));
+  if (ticket !== rec.asked) return;
+  fields = f;
+  PADS.forEach((p, k) => { images[p] = imgs[k]; });
+  showScalars(s);
+  PADS.forEach(drawPad);
+  $('frame-index').textContent = i;
+  rec.shown = i;
+}
+
+// Play at the recording's rate: each tick shows the last frame whose time has come.
+async function tick() {
+  if (!rec.playing) return;
+  const n = rec.states.length;
+  const target = rec.t0 + (performance.now() - rec.wall0) * 1000;
+  let i = rec.index;
+  while (i + 1 < n && rec.states[i + 1].t_us <= target) i++;
+  if (i !== rec.shown) await showFrame(i);
+  if (i >= n - 1) { setPlaying(false); return; }
+  setTimeout(tick, 1000 / 30);
+}
+
+function setPlaying(on) {
+  rec.playing = on;
+  $('play').textContent = on ? 'pause' : 'play';
+  if (!on) return;
+  if (rec.index >= rec.states.length - 1) rec.index = 0;
+  rec.wall0 = performance.now();
+  rec.t0 = rec.states[rec.index].t_us;
+  tick();
+}
+
+async function startRecording(info) {
+  document.title = 'tacse3-replay: ' + info.recording;
+  $('title').textContent = 'tacse3-replay';
+  $('link').hidden = true;
+  document.querySelector('section.controls').hidden = true;
+  $('recording').hidden = false;
+  $('plots-title').textContent = 'the recording';
+  // A replay has no DSP timing, latency or CAN counters.
+  for (const el of [$('dsp').parentElement, $('latency').parentElement, $('counters'),
+                    $('plot-timing')]) el.hidden = true;
+  const r = await getJson('api/frames');
+  rec.states = r.states;
+  setupPlots(r.states.some((s) => s.truth !== undefined));
+  for (const s of r.states) record(s, true);
+  redrawPlots();
+  $('frame').max = r.frames - 1;
+  $('frame-count').textContent = r.frames;
+  $('frame').addEventListener('input', () => { setPlaying(false); showFrame(+$('frame').value); });
+  $('play').addEventListener('click', () => setPlaying(!rec.playing));
+  await showFrame(0);
+}
+
+async function start() {
+  const info = await showInfo();
+  if (info && info.recording) return startRecording(info);
+  setupPlots(false);
+  connect();
+  refreshImages();
+  setInterval(redrawPlots, 100);
+}
+
 for (const id of ['show-shear', 'show-contact', 'show-fz'])
   $(id).addEventListener('change', () => PADS.forEach(drawPad));
+start();
+// For the browser tests.
 window.tacse3 = { series, last: () => last, plots: () => plots.length, pose3d: () => drawnPose,
-                   poseAxes };  // for the browser test
+                   poseAxes, plotData: (k) => plots[k].plot.data,
+                   recording: () => ({ index: rec.index, shown: rec.shown,
+                                       frames: rec.states.length, playing: rec.playing }) };

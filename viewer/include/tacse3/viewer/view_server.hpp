@@ -10,6 +10,7 @@
 
 #include "tacse3/config/listen_address.hpp"
 #include "tacse3/viewer/command_mailbox.hpp"
+#include "tacse3/viewer/view_json.hpp"
 #include "tacse3/viewer/view_snapshot.hpp"
 
 namespace tacse3::viewer {
@@ -39,11 +40,38 @@ bool parse_web_command(const std::string& body, protocol::Command* command, std:
 // tree's). Empty when it holds no index.html.
 std::filesystem::path find_viewer_assets(const std::filesystem::path& exe_dir);
 
+struct Rendered;
+
+// A recording's frames as tacse3-replay --view serves them: each rendered once when added (its
+// JSON and JPEGs), and kept with its snapshot for /api/fields (about 90 kB a frame).
+class RecordedViews {
+ public:
+  RecordedViews();
+  ~RecordedViews();
+  RecordedViews(RecordedViews&&) noexcept;
+  RecordedViews& operator=(RecordedViews&&) noexcept;
+
+  // Appends the next frame; `truth`, when not null, is the recording's truth at its time.
+  void add(const ViewSnapshot& snapshot, const ViewTruth* truth);
+  std::size_t size() const noexcept;
+  const std::shared_ptr<const Rendered>& at(std::size_t i) const;
+  // GET /api/frames: {"frames":N,"states":[every frame's /api/state document]}.
+  std::string frames_json() const;
+
+ private:
+  struct Frames;
+  std::unique_ptr<Frames> frames_;
+};
+
 class ViewServer {
  public:
   // Loads the assets, binds and starts serving, reading snapshots from `slot` (this server is its
   // only reader). null with *error ("ADDR:PORT: address already in use", a missing asset).
   static std::unique_ptr<ViewServer> start(const ViewServerConfig& config, ViewSlot& slot,
+                                           std::string* error);
+  // The same page for a recording: /api/state, /api/fields and the images take ?frame=N, and
+  // /api/frames gives every frame's state; no stream and no controls (docs/viewer.md).
+  static std::unique_ptr<ViewServer> start(const ViewServerConfig& config, RecordedViews recording,
                                            std::string* error);
   ~ViewServer();  // stops serving and joins every thread
   ViewServer(const ViewServer&) = delete;
@@ -61,6 +89,7 @@ class ViewServer {
 
  private:
   explicit ViewServer(std::unique_ptr<Impl> impl);
+  static std::unique_ptr<ViewServer> serve(std::unique_ptr<Impl> impl, std::string* error);
   std::unique_ptr<Impl> impl_;
 };
 
