@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""tacse3-replay --view in headless Chromium (Debian's chromium, chromium-driver, python3-selenium).
+
+Renders a short simulator recording with truth (tacse3-sim), serves it with tacse3-replay REC
+--view 127.0.0.1:PORT and checks that: the page opens on frame 0; the scrubber moves the frame
+shown (the cycle and time readouts, the pad image and the 3D view change, and the 3D view draws
+that frame's pose and truth); play advances the frames at the recording's rate and pause stops
+it; the pose plot holds the truth series, equal at every frame to truth.csv's rotation vector.
+Saves a screenshot to --screenshot. Exit 77 (ctest: skipped) when Chromium, its driver or
+selenium is missing.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+
+from pose3d_check import check_pose3d
+
+SKIP = 77
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def wait_for(what, fn, timeout_s):
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        value = fn()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+
+
+def rotation_vector_deg(q):
+    """The page's angle-axis: the short way round, angle times the unit axis, degrees."""
+    w, x, y, z = q
+    if w < 0:
+        w, x, y, z = -w, -x, -y, -z
+    s = math.sqrt(x * x + y * y + z * z)
+    if s < 1e-12:
+        return [0.0, 0.0, 0.0]
+    angle = 2 * math.degrees(math.atan2(s, w))
+    return [angle * x / s, angle * y / s, angle * z / s]
+
+
+def selenium_or_none():
+    try:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.options import Options
+        from selenium.webdriver.chrome.service import Service
+        return webdriver, Options, Service
+    except ImportError:
+        return None
+
+
+def check_scrub(js, base, frames, mid):
+    """The scrubber to frame `mid`: the readouts, the image and the 3D view follow."""
+    img0 = js("return document.querySelector('#pad-left canvas').toDataURL()")
+    js("const f = document.getElementById('frame'); f.value = arguments[0];"
+       "f.dispatchEvent(new Event('input'));", mid)
+    wait_for(f"frame {mid} shown", lambda: js("return window.tacse3.recording().shown") == mid, 10)
+    api = json.loads(urllib.request.urlopen(f"{base}/api/state?frame={mid}", timeout=5).read())
+    cycle = js("return document.getElementById('cycle').textContent")
+    t_shown = js("return document.getElementById('t').textContent")
+    assert cycle == str(mid + 1), f"cycle readout {cycle!r} at frame {mid}"
+    assert abs(float(t_shown) - api["t_us"] / 1e6) < 0.0006, f"time readout {t_shown} at {mid}"
+    assert js("return document.getElementById('frame-index').textContent") == str(mid)
+    img1 = js("return document.querySelector('#pad-left canvas').toDataURL()")
+    assert img1 != img0, "the left pad's image did not change with the frame"
+    drawn = js("return window.tacse3.pose3d()")
+    worst = check_pose3d(drawn, api["pose"]["q"], api["pose"]["p"])
+    assert "truth" in api, "a frame of a recording with truth.csv has no truth"
+    assert not js("return document.getElementById('truth-caption').hidden")
+    print(f"scrubber: frame {mid} of {frames}, cycle {cycle}, t {t_shown} s, image changed, "
+          f"3D view within {worst:.2g} px of the frame's pose")
+
+
+def check_play(js, browser, states):
+    """Play from frame 0 for about 1 s of wall time: the frame shown advances at the recording's
+    rate (within the page's 33 ms tick and a frame); pause holds it."""
+    js("const f = document.getElementById('frame'); f.value = 0;"
+       "f.dispatchEvent(new Event('input'));")
+    wait_for("frame 0 shown", lambda: js("return window.tacse3.recording().shown") == 0, 10)
+    browser.find_element("id", "play").click()
+    t0 = time.monotonic()
+    time.sleep(1.0)
+    now = js("return window.tacse3.recording()")
+    elapsed = time.monotonic() - t0
+    browser.find_element("id", "play").click()
+    shown, asked = now["shown"], now["index"]
+    print(f"play: after {elapsed:.3f} s, frame {asked} asked for, {shown} shown")
+    assert 0 < shown <= asked, "play did not advance the frame shown"
+    played_s = (states[asked]["t_us"] - states[0]["t_us"]) / 1e6
+    period_s = (states[1]["t_us"] - states[0]["t_us"]) / 1e6
+    assert played_s <= elapsed + period_s, f"played {played_s:.3f} s of the recording in {elapsed:.3f} s"
+    assert played_s >= elapsed - 0.35, f"played only {played_s:.3f} s in {elapsed:.3f} s"
+    time.sleep(0.3)
+    held = js("return window.tacse3.recording()")
+    assert not held["playing"], "pause did not stop playing"
+    time.sleep(0.3)
+    assert js("return window.tacse3.recording().index") == held["index"], "frames moved on pause"
+    print(f"play: {played_s:.3f} s of the recording in {elapsed:.3f} s; pause holds")
+
+
+def check_truth_plot(js, rec_dir, states):
+    """The pose plot's truth series at every frame is truth.csv's rotation vector there."""
+    data = js("return window.tacse3.plotData(2)")
+    assert len(data) == 7, f"the pose plot has {len(data) - 1} series, not 3 estimated + 3 truth"
+    with open(os.path.join(rec_dir, "truth.csv")) as f:
+        rows = list(csv.DictReader(f))  # tacse3-sim writes one row per frame, at its time
+    assert len(rows) == len(states), f"truth.csv has {len(rows)} rows for {len(states)} frames"
+    worst, peak = 0.0, 0.0
+    for k, (s, row) in enumerate(zip(states, rows)):
+        assert int(row["t_ns"]) // 1000 == s["t_us"], f"frame {k}: truth row at {row['t_ns']} ns"
+        want = rotation_vector_deg([float(row[c]) for c in ("qw", "qx", "qy", "qz")])
+        got = [data[4 + i][k] for i in range(3)]
+        worst = max(worst, max(abs(a - b) for a, b in zip(got, want)))
+        peak = max(peak, abs(want[2]))
+    assert worst < 1e-4, f"the truth series differs from truth.csv by {worst:.3g} deg"
+    assert peak > 5, f"the truth turns only {peak:.2f} deg about z: not the rendered motion"
+    print(f"pose plot: truth series = truth.csv over {len(states)} frames (within {worst:.2g} "
+          f"deg; peak {peak:.2f} deg about z)")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sim", required=True)
+    ap.add_argument("--replay", required=True)
+    ap.add_argument("--screenshot", required=True)
+    args = ap.parse_args()
+
+    chromium, driver, sel = shutil.which("chromium"), shutil.which("chromedriver"), selenium_or_none()
+    if not chromium or not driver or sel is None:
+        print("browser test skipped: needs Debian's chromium, chromium-driver and python3-selenium "
+              "(scripts/setup.sh installs them)")
+        return SKIP
+    webdriver, Options, Service = sel
+
+    tmp = tempfile.mkdtemp(prefix="tacse3-replay-view-")
+    rec = os.path.join(tmp, "rec")
+    # 1.5 s at 120 Hz: the sphere turns 20 degrees about z in 0.5 s (docs/simulator.md).
+    subprocess.run([args.sim, "-o", rec, "--magnitude", "20", "--motion-s", "0.5", "-q"],
+                   check=True)
+    port = free_port()
+    base = f"http://127.0.0.1:{port}"
+    log = open(args.screenshot + ".replay.log", "w")
+    replay = subprocess.Popen([args.replay, rec, "--out", os.path.join(tmp, "out.csv"), "-q",
+                               "--view", f"127.0.0.1:{port}"], stdout=log, stderr=log)
+    browser = None
+    try:
+        def info():
+            try:
+                return json.loads(urllib.request.urlopen(base + "/api/info", timeout=1).read())
+            except OSError:
+                return None
+        assert wait_for("/api/info", info, 30)["recording"] == rec
+        frames = json.loads(urllib.request.urlopen(base + "/api/frames", timeout=5).read())
+        states = frames["states"]
+        assert frames["frames"] == len(states) == 180, f"{frames['frames']} frames served"
+
+        opts = Options()
+        opts.binary_location = chromium
+        for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1500,1600",
+                  "--disable-dev-shm-usage"):
+            opts.add_argument(a)
+        browser = webdriver.Chrome(service=Service(driver), options=opts)
+        browser.get(base + "/")
+        js = browser.execute_script
+        wait_for("frame 0", lambda: js("return window.tacse3.recording().shown") == 0, 15)
+        assert js("return document.getElementById('cycle').textContent") == "1"
+        assert js("return document.getElementById('plots-missing').hidden"), "no uPlot bundled"
+        check_scrub(js, base, len(states), 120)
+        check_truth_plot(js, rec, states)
+        check_play(js, browser, states)
+        # The screenshot on the frame where the object has turned most.
+        js("const f = document.getElementById('frame'); f.value = 150;"
+           "f.dispatchEvent(new Event('input'));")
+        wait_for("frame 150", lambda: js("return window.tacse3.recording().shown") == 150, 10)
+        browser.save_screenshot(args.screenshot)
+        print(f"screenshot: {args.screenshot}")
+        return 0
+    finally:
+        if browser is not None:
+            browser.quit()
+        replay.terminate()
+        rc = replay.wait(timeout=20)
+        log.close()
+        shutil.rmtree(tmp, ignore_errors=True)
+        if rc != 0:
+            print(f"tacse3-replay --view exited {rc} on SIGTERM (expected 0)")
+            sys.exit(1)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
