@@ -127,6 +127,8 @@ def main():
         assert js("return document.getElementById('plots-missing').hidden"), \
             "the page says the plots are missing (uPlot not bundled)"
         assert js("return window.tacse3.plots()") == 6, "not every plot was created"
+        assert js("return getComputedStyle(document.getElementById('recording')).display") == \
+            "none", "the live page shows the recording's timeline"
 
         # The plots move: more samples, and the ω plot's pixels change.
         plot_png = "return document.querySelector('#plot-w canvas').toDataURL()"

@@ -269,17 +269,20 @@ TEST_F(ViewServerTest, ARecordingIsServedFrameByFrame) {
   server_ = ViewServer::start(config_, std::move(views), &e);
   ASSERT_TRUE(server_) << e;
   for (int i = 0; i < 3; ++i) {
-    const std::string q = "?frame=" + std::to_string(i);
-    EXPECT_EQ(body_of(exchange(port(), get("/api/state" + q))), states[static_cast<size_t>(i)]);
-    const std::string image = exchange(port(), get("/api/image/left.jpg" + q));
+    const std::string q = std::string("?frame=").append(std::to_string(i));
+    EXPECT_EQ(body_of(exchange(port(), get(std::string("/api/state").append(q)))),
+              states[static_cast<size_t>(i)]);
+    const std::string image = exchange(port(), get(std::string("/api/image/left.jpg").append(q)));
     EXPECT_EQ(status_of(image), 200);
-    EXPECT_NE(image.find("X-Cycle: " + std::to_string(i + 1) + "\r\n"), std::string::npos);
-    EXPECT_NE(body_of(exchange(port(), get("/api/fields" + q)))
-                  .find("{\"cycle\":" + std::to_string(i + 1) + ","),
+    EXPECT_NE(image.find(std::string("X-Cycle: ").append(std::to_string(i + 1)).append("\r\n")),
+              std::string::npos);
+    EXPECT_NE(body_of(exchange(port(), get(std::string("/api/fields").append(q))))
+                  .find(std::string("{\"cycle\":").append(std::to_string(i + 1)).append(",")),
               std::string::npos);
   }
   EXPECT_EQ(body_of(exchange(port(), get("/api/frames"))),
-            "{\"frames\":3,\"states\":[" + states[0] + "," + states[1] + "," + states[2] + "]}");
+            std::string("{\"frames\":3,\"states\":[") + states[0] + "," + states[1] + "," +
+                states[2] + "]}");
   const std::string none = exchange(port(), get("/api/state"));
   EXPECT_EQ(status_of(none), 400);
   EXPECT_EQ(body_of(none), "{\"error\":\"give the frame: ?frame=N, N in 0..2\"}\n");

@@ -273,7 +273,8 @@ int run(int argc, char** argv) {
   sinks.progress = &bar;
   std::unique_ptr<tt::ReplayView> viewer;
   if (!view.empty()) {
-    if (const char* why = tt::ReplayView::unavailable()) return fail("--view: " + std::string(why));
+    if (const char* why = tt::ReplayView::unavailable())
+      return fail(std::string("--view: ").append(why));
     viewer = std::make_unique<tt::ReplayView>(info, opt.calibration.fitted);
     sinks.on_frame = [viewer = viewer.get(), log = sinks.on_frame](
                          std::size_t i, const tt::FrameResult& r, const tt::Replayer& engine) {
@@ -286,7 +287,7 @@ int run(int argc, char** argv) {
     if (!viewer) return 0;
     std::fflush(stdout);
     const std::string e = viewer->serve(view_at, cal_text);
-    return e.empty() ? 0 : fail("--view " + view + ": " + e);
+    return e.empty() ? 0 : fail(std::string("--view ").append(view).append(": ").append(e));
   };
 
   const tt::ReplayRun run = tt::run_replay(*source, opt, sinks);

@@ -463,17 +463,21 @@ std::shared_ptr<const Rendered> ViewServer::Impl::pick(const httplib::Request& r
     return r;
   }
   const std::string n = req.get_param_value("frame");
-  const std::string range = "0.." + std::to_string(recorded.size() - 1);
+  const std::string range = std::string("0..").append(std::to_string(recorded.size() - 1));
   char* end = nullptr;
   const unsigned long long i = std::strtoull(n.c_str(), &end, 10);
   if (n.empty() || n[0] < '0' || n[0] > '9' || *end != '\0') {
     *status = 400;
-    *error = "give the frame: ?frame=N, N in " + range;
+    *error = std::string("give the frame: ?frame=N, N in ").append(range);
     return nullptr;
   }
   if (i >= recorded.size()) {
     *status = 404;
-    *error = "frame " + n + " is not in the recording (" + range + ")";
+    *error = std::string("frame ")
+                 .append(n)
+                 .append(" is not in the recording (")
+                 .append(range)
+                 .append(")");
     return nullptr;
   }
   return recorded.at(static_cast<std::size_t>(i));
@@ -598,7 +602,8 @@ const std::shared_ptr<const Rendered>& RecordedViews::at(std::size_t i) const {
 }
 
 std::string RecordedViews::frames_json() const {
-  std::string s = "{\"frames\":" + std::to_string(size()) + ",\"states\":[";
+  std::string s =
+      std::string("{\"frames\":").append(std::to_string(size())).append(",\"states\":[");
   for (std::size_t i = 0; i < size(); ++i) {
     if (i > 0) s += ',';
     s += frames_->frames[i]->state_json;
