@@ -26,10 +26,12 @@ PACKAGES=(
   libturbojpeg0-dev libgpiod-dev libcamera-dev
   # tacse3-replay --plot: SVG and PNG figures (host builds only; docs/replay.md)
   libcairo2-dev
-  # tacse3d --http, the live viewer: the HTTP server (docs/viewer.md says why this one)
+  # tacse3d --http and tacse3-replay --view, the web view: the HTTP server (docs/viewer.md says
+  # why this one)
   libcpp-httplib-dev
-  # its browser tests (tests/viewer): headless Chromium driven by selenium
-  chromium chromium-driver python3-selenium
+  # its browser tests (tests/viewer): headless Chromium driven by selenium, and headless
+  # Firefox driven over Marionette by a Perl module (Debian has no geckodriver)
+  chromium chromium-driver python3-selenium firefox-esr libfirefox-marionette-perl
   # the daemon: systemd notify/watchdog; packaging: dpkg-deb and file for the .deb checks,
   # help2man for the manual pages made from each program's --help
   libsystemd-dev dpkg-dev file help2man
