@@ -6,7 +6,7 @@ Starts tacse3d --board BOARD --http 127.0.0.1:PORT with the board's [viewer] con
 the page and checks that the stream is live, the plots move, both pad canvases show an image (not
 blank), the left pad reads OK, the pose readout and the 3D view's end points match /api/state on
 the same cycle, and that the tare button is answered with an ACK shown on the page and restarts
-the pose. Saves a screenshot to --screenshot.
+the pose. Saves a screenshot (before the tare) to --screenshot.
 Exit 77 (ctest: skipped) with a message when Chromium, its driver or selenium is missing.
 """
 import argparse
@@ -173,6 +173,8 @@ def main():
         assert js("return document.getElementById('controls-off').hidden"), "controls shown off"
         before = wait_for("the object to turn 8 degrees", lambda: (lambda cq: cq if angle_of(
             cq[1]) >= 8 else None)(js(page_pose)), 20)
+        # The screenshot with the object turned, the 3D view showing it.
+        browser.save_screenshot(args.screenshot)
         browser.find_element("id", "cmd-tare").click()
         ack = wait_for("the tare's answer on the page", lambda: (lambda t: t if "code" in t else
                        None)(js("return document.getElementById('ack').textContent")), 5)
@@ -187,7 +189,6 @@ def main():
         print(f"tare: {ack!r}; pose angle {a0:.2f} deg at cycle {before[0]}, "
               f"{a1:.2f} deg at cycle {after[0]}")
 
-        browser.save_screenshot(args.screenshot)
         print(f"screenshot: {args.screenshot}")
         return 0
     finally:

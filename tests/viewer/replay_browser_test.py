@@ -5,8 +5,8 @@
 Renders a short simulator recording with truth (tacse3-sim), serves it with tacse3-replay REC
 --view 127.0.0.1:PORT and checks that: the page opens on frame 0; the scrubber moves the frame
 shown (the cycle and time readouts, the pad image and the 3D view change, and the 3D view draws
-that frame's pose and truth); play advances the frames at the recording's rate and pause stops
-it; the pose plot holds the truth series, equal at every frame to truth.csv's rotation vector.
+that frame's pose and truth); play runs through the recording on its clock (never ahead of it,
+not done sooner, stopping on the last frame) and pause stops it; the pose plot holds the truth series, equal at every frame to truth.csv's rotation vector.
 Saves a screenshot to --screenshot. Exit 77 (ctest: skipped) when Chromium, its driver or
 selenium is missing.
 """
@@ -89,30 +89,42 @@ def check_scrub(js, base, frames, mid):
 
 
 def check_play(js, browser, states):
-    """Play from frame 0 for about 1 s of wall time: the frame shown advances at the recording's
-    rate (within the page's 33 ms tick and a frame); pause holds it."""
+    """Play from frame 0 to the end: never ahead of the recording's clock, not done before the
+    recording's duration, through frames in between, stopping on the last; then pause holds. (How
+    far play lags the clock is one frame's fetch, which depends on the machine's load: only
+    bounded loosely.)"""
     js("const f = document.getElementById('frame'); f.value = 0;"
        "f.dispatchEvent(new Event('input'));")
     wait_for("frame 0 shown", lambda: js("return window.tacse3.recording().shown") == 0, 10)
+    period_s = (states[1]["t_us"] - states[0]["t_us"]) / 1e6
+    duration_s = (states[-1]["t_us"] - states[0]["t_us"]) / 1e6
     browser.find_element("id", "play").click()
     t0 = time.monotonic()
-    time.sleep(1.0)
-    now = js("return window.tacse3.recording()")
+    seen, ahead = set(), 0.0
+    while time.monotonic() - t0 < duration_s + 15:
+        now = js("return window.tacse3.recording()")
+        elapsed = time.monotonic() - t0
+        seen.add(now["shown"])
+        ahead = max(ahead, (states[now["index"]]["t_us"] - states[0]["t_us"]) / 1e6 - elapsed)
+        if not now["playing"]:
+            break
+        time.sleep(0.05)
     elapsed = time.monotonic() - t0
-    browser.find_element("id", "play").click()
-    shown, asked = now["shown"], now["index"]
-    print(f"play: after {elapsed:.3f} s, frame {asked} asked for, {shown} shown")
-    assert 0 < shown <= asked, "play did not advance the frame shown"
-    played_s = (states[asked]["t_us"] - states[0]["t_us"]) / 1e6
-    period_s = (states[1]["t_us"] - states[0]["t_us"]) / 1e6
-    assert played_s <= elapsed + period_s, f"played {played_s:.3f} s of the recording in {elapsed:.3f} s"
-    assert played_s >= elapsed - 0.35, f"played only {played_s:.3f} s in {elapsed:.3f} s"
+    assert not now["playing"], f"still playing {elapsed:.1f} s into a {duration_s:.2f} s recording"
+    assert now["shown"] == len(states) - 1, f"play stopped on frame {now['shown']}, not the last"
+    assert ahead <= period_s + 0.05, f"play ran {ahead:.3f} s ahead of the recording's clock"
+    assert elapsed >= duration_s - 0.05, f"played {duration_s:.2f} s in {elapsed:.2f} s"
+    assert len(seen) >= 3, f"play showed only frames {sorted(seen)}"
+    print(f"play: {duration_s:.3f} s of the recording in {elapsed:.3f} s, {len(seen)} frames "
+          f"shown, never more than {max(ahead, 0.0) * 1e3:.0f} ms ahead of its clock")
+    browser.find_element("id", "play").click()  # from the start again
     time.sleep(0.3)
+    browser.find_element("id", "play").click()
     held = js("return window.tacse3.recording()")
     assert not held["playing"], "pause did not stop playing"
     time.sleep(0.3)
     assert js("return window.tacse3.recording().index") == held["index"], "frames moved on pause"
-    print(f"play: {played_s:.3f} s of the recording in {elapsed:.3f} s; pause holds")
+    print(f"pause: holds frame {held['index']}")
 
 
 def check_truth_plot(js, rec_dir, states):

@@ -28,7 +28,7 @@ function angleAxis(q) {
 const POSE_AXIS_MM = 10;      // every drawn axis is 10 mm long
 const POSE_P_SCALE = 5;       // the displacement p is drawn 5x
 const POSE_PX_PER_MM = 9;     // canvas pixels per (drawn) millimetre
-const EYE = [0.45, -0.55, 0.70];
+const EYE = [-0.3, -0.4, 0.87];  // near G z: a turn about the grasp axis shows in the plane
 const UP = [1, 0, 0];
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
