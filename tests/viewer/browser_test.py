@@ -10,36 +10,15 @@ the pose. Saves a screenshot (before the tare) to --screenshot.
 Exit 77 (ctest: skipped) with a message when Chromium, its driver or selenium is missing.
 """
 import argparse
-import json
 import math
 import os
 import shutil
-import socket
 import subprocess
 import sys
 import time
-import urllib.request
 
 from pose3d_check import check_pose3d
-
-SKIP = 77
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def wait_for(what, fn, timeout_s):
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        value = fn()
-        if value:
-            return value
-        time.sleep(0.1)
-    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
-
+from viewer_support import SKIP, free_port, get_json, wait_for
 
 # Standard deviation of a canvas's luma (the image with its overlays), computed in the page.
 CANVAS_SD = """
@@ -105,13 +84,7 @@ def main():
                               stdout=subprocess.DEVNULL, stderr=log)
     browser = None
     try:
-        def state():
-            try:
-                with urllib.request.urlopen(base + "/api/state", timeout=1) as r:
-                    return json.loads(r.read())
-            except OSError:
-                return None
-        wait_for("/api/state", state, 15)
+        wait_for("/api/state", lambda: get_json(base + "/api/state"), 15)
 
         opts = Options()
         opts.binary_location = chromium
@@ -153,7 +126,7 @@ def main():
             cycle, shown, drawn = js("return [window.tacse3.last().cycle, "
                                      "document.getElementById('angle').textContent, "
                                      "window.tacse3.pose3d()]")
-            api = state()
+            api = get_json(base + "/api/state")
             return (shown, drawn, api) if api and api["cycle"] == cycle else None
         shown, drawn, api = wait_for("the page and /api/state on one cycle", same_cycle, 10)
         w = min(1.0, abs(api["pose"]["q"][0]))

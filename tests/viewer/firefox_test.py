@@ -8,17 +8,12 @@ Renders the recording of replay_browser_test.py, serves it and runs firefox_chec
 saves --screenshot. Exit 77 (ctest: skipped) when Firefox or the Perl module is missing.
 """
 import argparse
-import json
 import os
 import shutil
 import subprocess
 import sys
-import tempfile
-import urllib.request
 
-from replay_browser_test import free_port, wait_for
-
-SKIP = 77
+from viewer_support import SKIP, served_recording
 
 
 def main():
@@ -34,34 +29,16 @@ def main():
               "(scripts/setup.sh installs them)")
         return SKIP
 
-    tmp = tempfile.mkdtemp(prefix="tacse3-replay-firefox-")
-    rec = os.path.join(tmp, "rec")
-    subprocess.run([args.sim, "-o", rec, "--magnitude", "20", "--motion-s", "0.5", "-q"],
-                   check=True)
-    port = free_port()
-    url = f"http://127.0.0.1:{port}/"
-    log = open(args.screenshot + ".replay.log", "w")
-    replay = subprocess.Popen([args.replay, rec, "--out", os.path.join(tmp, "out.csv"), "-q",
-                               "--view", f"127.0.0.1:{port}"], stdout=log, stderr=log)
-    try:
-        def info():
-            try:
-                return json.loads(urllib.request.urlopen(url + "api/info", timeout=1).read())
-            except OSError:
-                return None
-        wait_for("/api/info", info, 30)
+    with served_recording(args.sim, args.replay, args.screenshot + ".replay.log",
+                          "tacse3-replay-firefox-") as (rec, base, _):
         check = os.path.join(os.path.dirname(os.path.abspath(__file__)), "firefox_check.pl")
         # Firefox wants a writable home for its profile; a fresh one keeps runs independent.
-        env = dict(os.environ, HOME=os.path.join(tmp, "home"))
+        env = dict(os.environ, HOME=os.path.join(os.path.dirname(rec), "home"))
         os.makedirs(env["HOME"])
-        rc = subprocess.run(["perl", check, url, args.screenshot], env=env, timeout=240).returncode
-        print(f"screenshot: {args.screenshot}" if rc == 0 else f"firefox_check.pl exited {rc}")
-        return 0 if rc == 0 else 1
-    finally:
-        replay.terminate()
-        replay.wait(timeout=20)
-        log.close()
-        shutil.rmtree(tmp, ignore_errors=True)
+        rc = subprocess.run(["perl", check, base + "/", args.screenshot], env=env,
+                            timeout=240).returncode
+    print(f"screenshot: {args.screenshot}" if rc == 0 else f"firefox_check.pl exited {rc}")
+    return 0 if rc == 0 else 1
 
 
 if __name__ == "__main__":

@@ -16,32 +16,12 @@ import json
 import math
 import os
 import shutil
-import socket
-import subprocess
 import sys
-import tempfile
 import time
 import urllib.request
 
 from pose3d_check import check_pose3d
-
-SKIP = 77
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def wait_for(what, fn, timeout_s):
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        value = fn()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+from viewer_support import SKIP, served_recording, wait_for
 
 
 def rotation_vector_deg(q):
@@ -161,24 +141,9 @@ def main():
         return SKIP
     webdriver, Options, Service = sel
 
-    tmp = tempfile.mkdtemp(prefix="tacse3-replay-view-")
-    rec = os.path.join(tmp, "rec")
-    # 1.5 s at 120 Hz: the sphere turns 20 degrees about z in 0.5 s (docs/simulator.md).
-    subprocess.run([args.sim, "-o", rec, "--magnitude", "20", "--motion-s", "0.5", "-q"],
-                   check=True)
-    port = free_port()
-    base = f"http://127.0.0.1:{port}"
-    log = open(args.screenshot + ".replay.log", "w")
-    replay = subprocess.Popen([args.replay, rec, "--out", os.path.join(tmp, "out.csv"), "-q",
-                               "--view", f"127.0.0.1:{port}"], stdout=log, stderr=log)
-    browser = None
-    try:
-        def info():
-            try:
-                return json.loads(urllib.request.urlopen(base + "/api/info", timeout=1).read())
-            except OSError:
-                return None
-        assert wait_for("/api/info", info, 30)["recording"] == rec
+    with served_recording(args.sim, args.replay, args.screenshot + ".replay.log",
+                          "tacse3-replay-view-") as (rec, base, info):
+        assert info["recording"] == rec, f"/api/info names {info['recording']}"
         frames = json.loads(urllib.request.urlopen(base + "/api/frames", timeout=5).read())
         states = frames["states"]
         assert frames["frames"] == len(states) == 180, f"{frames['frames']} frames served"
@@ -189,31 +154,24 @@ def main():
                   "--disable-dev-shm-usage"):
             opts.add_argument(a)
         browser = webdriver.Chrome(service=Service(driver), options=opts)
-        browser.get(base + "/")
-        js = browser.execute_script
-        wait_for("frame 0", lambda: js("return window.tacse3.recording().shown") == 0, 15)
-        assert js("return document.getElementById('cycle').textContent") == "1"
-        assert js("return document.getElementById('plots-missing').hidden"), "no uPlot bundled"
-        check_scrub(js, base, len(states), 120)
-        check_truth_plot(js, rec, states)
-        check_play(js, browser, states)
-        # The screenshot on the frame where the object has turned most.
-        js("const f = document.getElementById('frame'); f.value = 150;"
-           "f.dispatchEvent(new Event('input'));")
-        wait_for("frame 150", lambda: js("return window.tacse3.recording().shown") == 150, 10)
-        browser.save_screenshot(args.screenshot)
-        print(f"screenshot: {args.screenshot}")
-        return 0
-    finally:
-        if browser is not None:
+        try:
+            browser.get(base + "/")
+            js = browser.execute_script
+            wait_for("frame 0", lambda: js("return window.tacse3.recording().shown") == 0, 15)
+            assert js("return document.getElementById('cycle').textContent") == "1"
+            assert js("return document.getElementById('plots-missing').hidden"), "no uPlot bundled"
+            check_scrub(js, base, len(states), 120)
+            check_truth_plot(js, rec, states)
+            check_play(js, browser, states)
+            # The screenshot on the frame where the object has turned most.
+            js("const f = document.getElementById('frame'); f.value = 150;"
+               "f.dispatchEvent(new Event('input'));")
+            wait_for("frame 150", lambda: js("return window.tacse3.recording().shown") == 150, 10)
+            browser.save_screenshot(args.screenshot)
+            print(f"screenshot: {args.screenshot}")
+        finally:
             browser.quit()
-        replay.terminate()
-        rc = replay.wait(timeout=20)
-        log.close()
-        shutil.rmtree(tmp, ignore_errors=True)
-        if rc != 0:
-            print(f"tacse3-replay --view exited {rc} on SIGTERM (expected 0)")
-            sys.exit(1)
+    return 0
 
 
 if __name__ == "__main__":
