@@ -406,7 +406,7 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
 
   if (const toml::table* t = rd.table(root, "sim", "")) {
     rd.only_keys(*t, "sim",
-                 {"object", "motion", "magnitude", "regime", "seed", "repeat", "realtime"});
+                 {"object", "motion", "magnitude", "regime", "seed", "repeat", "realtime", "plan"});
     rd.string(*t, "object", "sim", &b.sim.object);
     check_sim_object(rd, *t, b.sim.object);
     rd.choice<std::string>(*t, "motion", "sim",
@@ -420,6 +420,20 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
     b.sim.seed = static_cast<std::uint64_t>(seed);
     rd.boolean(*t, "repeat", "sim", &b.sim.repeat);
     rd.boolean(*t, "realtime", "sim", &b.sim.realtime);
+    rd.string(*t, "plan", "sim", &b.sim.plan);
+    if (rd.ok() && t->get("plan") != nullptr) {
+      if (b.sim.plan.empty()) {
+        rd.fail(t->get("plan"), "key \"sim.plan\" must name a plan CSV file, got \"\"");
+      } else if (!std::filesystem::path(b.sim.plan).is_absolute()) {
+        b.sim.plan = (std::filesystem::path(origin).parent_path() / b.sim.plan).string();
+      }
+    }
+    // The plan's motions are timed by the controller's waits: they play in real time.
+    if (rd.ok() && !b.sim.plan.empty() && !b.sim.realtime) {
+      rd.fail(t->get("realtime"),
+              "key \"sim.realtime\" must be true with sim.plan (the plan's "
+              "motions play in real time, as the controller waits for them)");
+    }
   }
 
   if (const toml::table* t = rd.table(root, "pipeline", "")) {
@@ -636,6 +650,7 @@ std::string describe(const BoardConfig& b) {
     s << "  sim: " << b.sim.object << ", motion " << b.sim.motion << " " << b.sim.magnitude << ", "
       << b.sim.regime << ", seed " << b.sim.seed << (b.sim.repeat ? ", repeat" : "")
       << (b.sim.realtime ? ", real time" : ", as fast as possible") << "\n";
+    if (!b.sim.plan.empty()) s << "  sim plan: " << b.sim.plan << " (one motion per recording)\n";
   }
   s << "  pipeline: " << (b.pipeline.method == dsp::FusionMethod::kJoint ? "joint" : "paper")
     << " fusion, proxy " << protocol::to_string(b.pipeline.velocity_proxy)

@@ -304,6 +304,33 @@ TEST(Board, RecordDirIsAnAbsolutePath) {
   EXPECT_NE(type.find("key \"record.dir\" must be a string"), std::string::npos) << type;
 }
 
+// [sim] plan: a relative path is the board file's folder's; it needs realtime.
+TEST(Board, SimPlanIsResolvedFromTheBoardFilesFolder) {
+  BoardConfig b;
+  std::string e;
+  ASSERT_TRUE(parse_board(kMinimal, "/etc/b/board.toml", &b, &e)) << e;
+  EXPECT_EQ(b.sim.plan, "") << "no plan: the [sim] scenario plays";
+  ASSERT_TRUE(parse_board(std::string(kMinimal) + "[sim]\nplan = \"plan.csv\"\n",
+                          "/etc/b/board.toml", &b, &e))
+      << e;
+  EXPECT_EQ(b.sim.plan, "/etc/b/plan.csv");
+  ASSERT_TRUE(parse_board(std::string(kMinimal) + "[sim]\nplan = \"/srv/p.csv\"\n",
+                          "/etc/b/board.toml", &b, &e))
+      << e;
+  EXPECT_EQ(b.sim.plan, "/srv/p.csv");
+  EXPECT_NE(describe(b).find("sim plan: /srv/p.csv (one motion per recording)"), std::string::npos)
+      << describe(b);
+  const std::string empty = error_of(std::string(kMinimal) + "[sim]\nplan = \"\"\n");
+  EXPECT_NE(empty.find("test.toml:5: key \"sim.plan\" must name a plan CSV file"),
+            std::string::npos)
+      << empty;
+  const std::string fast =
+      error_of(std::string(kMinimal) + "[sim]\nplan = \"p.csv\"\nrealtime = false\n");
+  EXPECT_NE(fast.find("test.toml:6: key \"sim.realtime\" must be true with sim.plan"),
+            std::string::npos)
+      << fast;
+}
+
 // [rig] tcp_to_grasp: a pose read with its quaternion normalised; absent means not given.
 TEST(Board, RigTcpToGraspIsReadAndNormalised) {
   BoardConfig b;

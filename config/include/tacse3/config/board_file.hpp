@@ -51,6 +51,10 @@ struct SimBoardConfig {
   std::uint64_t seed = 1;
   bool repeat = true;
   bool realtime = true;
+  // A calibration plan (tacse3-calibrate --plan --format csv) the simulated rig plays, one motion
+  // per START_RECORDING (docs/firmware.md, "Simulated rig"). A relative path is taken from the
+  // board file's folder; empty: no plan, the scenario above plays.
+  std::string plan;
 };
 
 // The finger separation range of board files, the same as SET_FINGER_SEPARATION's
