@@ -11,6 +11,7 @@
 
 #include "tacse3/hal/camera/clock.hpp"
 #include "tacse3/hal/camera/spsc_ring.hpp"
+#include "tacse3/sim/arm_log.hpp"
 #include "tacse3/sim/simulator.hpp"
 
 namespace tacse3::hal {
@@ -85,6 +86,7 @@ std::shared_ptr<SimRig> SimRig::create(const SimRigConfig& config, std::string* 
   std::shared_ptr<SimRig> rig(new SimRig());
   rig->config_ = config;
   rig->sim_ = std::move(s);
+  if (!sc.plan.empty() && !rig->load_plan(cfg, &e)) return fail(e);
   return rig;
 }
 
@@ -100,11 +102,17 @@ std::int64_t SimRig::grid_time_ns(std::int64_t k) const noexcept {
 }
 
 sim::Pose SimRig::truth(std::int64_t timestamp_ns) const noexcept {
+  if (has_plan()) {
+    const std::int64_t t_sim = sim_time_ns(timestamp_ns);
+    const double k = std::floor(static_cast<double>(t_sim) * config_.fps * 1e-9 + 1e-6);
+    const Segment seg = segments_[segment_at(static_cast<std::int64_t>(k))];
+    return motion_truth(seg.motion, seg.start_grid, t_sim);
+  }
   return sim_->truth(sim_time_ns(timestamp_ns));
 }
 
 sim::Twist SimRig::truth_twist(std::int64_t timestamp_ns) const noexcept {
-  return sim_->truth_twist(sim_time_ns(timestamp_ns));
+  return has_plan() ? sim::Twist{} : sim_->truth_twist(sim_time_ns(timestamp_ns));
 }
 
 std::int64_t SimRig::start_clock() noexcept {
@@ -210,7 +218,7 @@ CameraStatus SimCamera::start() {
   }
   Impl& m = *impl_;
   const std::int64_t t0 = rig_->start_clock();
-  rig_->sim_->reset(cfg_.sensor);
+  rig_->restart_pad(cfg_.sensor);
   m.grid = 0;
   m.seq = 0;
   m.carry_dropped = 0;
@@ -355,8 +363,8 @@ CameraStatus SimCamera::next_frame(Frame& frame, int timeout_ms) {
       int free_slot = 0;
       while (m.held[static_cast<std::size_t>(free_slot)]) ++free_slot;
       std::uint8_t* dst = m.pixels.get() + m.frame_bytes * static_cast<std::size_t>(free_slot);
-      const sim::SimStatus st = rig_->sim_->render(
-          cfg_.sensor, t_sim, std::span<std::uint8_t>(dst, m.frame_bytes), m.channels);
+      const sim::SimStatus st = rig_->render(
+          cfg_.sensor, m.grid, std::span<std::uint8_t>(dst, m.frame_bytes), m.channels);
       if (st != sim::SimStatus::kOk) {
         bump(m.n.corrupt);
         return CameraStatus::error(CameraError::kIo, "sim camera %s: simulator: %s", side,

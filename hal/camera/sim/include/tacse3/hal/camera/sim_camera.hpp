@@ -2,17 +2,24 @@
 // tacse3 hal: the live `sim` camera backend: two simulated pads from one shared simulation.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "tacse3/hal/camera.hpp"
+#include "tacse3/hal/camera/recorded_motion.hpp"
 #include "tacse3/sim/types.hpp"
 
 namespace tacse3::sim {
 class Simulator;
-}
+class ArmLog;
+struct SimConfig;
+}  // namespace tacse3::sim
 
 namespace tacse3::hal {
 
@@ -29,6 +36,9 @@ struct SimSceneConfig {
   // > 0: rescale the object so the pads sit this far apart when grasped ([pipeline]
   // finger_separation_m in mm); 0: the preset's own size.
   double finger_separation_mm = 0.0;
+  // A calibration plan CSV (tacse3-calibrate --plan --format csv). Given, the rig plays one of
+  // its motions per recording (RecordedMotion) instead of the scene above, and rests between.
+  std::string plan;
 };
 
 // The rig: the scene plus the frame geometry and rate shared by both pads.
@@ -37,6 +47,9 @@ struct SimRigConfig {
   int width = 320;  // the simulator renders multiples of 4 pixels; the pipeline needs 320 x 240
   int height = 240;
   int fps = 120;  // 1..1000
+  // With a plan: the pose of G in the robot's TCP frame (x, y, z in m, qw, qx, qy, qz), the
+  // board file's [rig] tcp_to_grasp, for the simulated robot's log.
+  std::array<double, 7> tcp_to_grasp{0, 0, 0, 1, 0, 0, 0};
 };
 
 // One simulated sensor. Everything a Camera needs, plus fault injection for tests and the
@@ -55,12 +68,23 @@ class SimCamera;
 // left and right frames with the same timestamp show the same instant of the same grasp.
 // Each pad keeps its own physical state inside the Simulator, so the two capture threads
 // render concurrently without a lock on the frame path.
-class SimRig : public std::enable_shared_from_this<SimRig> {
+//
+// With a plan (SimSceneConfig::plan) the rig is also the RecordedMotion of the daemon's
+// recordings: between recordings the pads rest open; each start_motion() plays the plan's next
+// motion from rest (pads open for its pads_open_s, grasp, settle, motion, hold, then held), and
+// stop_motion() opens the pads again and writes, in the recording's robot/ folder, the simulated
+// robot's TCP log (gripper.csv, sim::ArmLog: the format tacse3-truth --gripper-log reads, on
+// CLOCK_REALTIME, the clock a controller on this host stamps its CAN log with) and the
+// simulator's exact truth of the same frames (sim-truth.csv, truth.csv's format), which a real
+// rig does not have. A motion starts at a frame neither pad has rendered yet, so both pads
+// switch on the same frame.
+class SimRig : public std::enable_shared_from_this<SimRig>, public RecordedMotion {
  public:
   // Validates the configuration and builds the simulator (patterns, tables: ~0.1-0.3 s).
   // nullptr with *error naming the key ("[sim] object: ...") on a bad configuration.
+  // With a plan, *error names the plan file and line on a bad plan.
   static std::shared_ptr<SimRig> create(const SimRigConfig& config, std::string* error);
-  ~SimRig();
+  ~SimRig() override;
   SimRig(const SimRig&) = delete;
   SimRig& operator=(const SimRig&) = delete;
 
@@ -86,11 +110,32 @@ class SimRig : public std::enable_shared_from_this<SimRig> {
   sim::Pose truth(std::int64_t timestamp_ns) const noexcept;
   sim::Twist truth_twist(std::int64_t timestamp_ns) const noexcept;
 
+  // RecordedMotion (a plan only; without one, next_motion_problem() says so).
+  bool has_plan() const noexcept { return !plan_sims_.empty(); }
+  std::size_t plan_size() const noexcept { return plan_sims_.size(); }
+  std::string next_motion_problem() const override;
+  void start_motion(const std::filesystem::path& dir) override;
+  std::string stop_motion() override;
+
  private:
   friend class SimCamera;
   SimRig() = default;
   // Sets t0 on the first call (now + one period); later calls return the same t0.
   std::int64_t start_clock() noexcept;
+  // Renders pad s at grid frame k: the scene, or with a plan the motion (or rest) of frame k.
+  sim::SimStatus render(sim::Sensor s, std::int64_t k, std::span<std::uint8_t> out,
+                        int channels) noexcept;
+  void restart_pad(sim::Sensor s) noexcept;
+  bool load_plan(const sim::SimConfig& base, std::string* error);
+
+  // With a plan: from grid frame start_grid on the rig plays plan motion `motion` (-1: rest).
+  struct Segment {
+    int motion = -1;
+    std::int64_t start_grid = 0;
+  };
+  std::size_t segment_at(std::int64_t k) const noexcept;
+  bool append_segment(int motion);
+  sim::Pose motion_truth(int motion, std::int64_t start_grid, std::int64_t t_sim) const noexcept;
 
   SimRigConfig config_;
   std::unique_ptr<sim::Simulator> sim_;
@@ -99,6 +144,24 @@ class SimRig : public std::enable_shared_from_this<SimRig> {
   // of a rig behave as if triggered together: when one falls behind, both skip to the same
   // future instant, so their frames keep pairing instead of drifting apart on a loaded machine.
   std::atomic<std::int64_t> resume_grid_{0};
+
+  // Plan mode. The segments are appended by the RecordedMotion thread (entries first, then the
+  // count with release) and read by the capture threads: no lock on the frame path.
+  std::string plan_file_;
+  std::vector<std::unique_ptr<sim::Simulator>> plan_sims_;
+  std::unique_ptr<sim::Simulator> rest_sim_;  // pads open, no contact
+  std::unique_ptr<Segment[]> segments_;
+  std::size_t segment_capacity_ = 0;
+  std::atomic<std::size_t> segment_count_{0};
+  std::array<std::atomic<std::int64_t>, 2> rendered_{};  // last grid frame each pad rendered
+  struct PadPlay {  // each touched by its own pad's capture thread only
+    std::size_t segment = SIZE_MAX;
+    std::int64_t t_ns = -1;
+  };
+  std::array<PadPlay, 2> play_{};
+  std::size_t next_motion_ = 0;  // RecordedMotion thread only
+  std::filesystem::path motion_dir_;
+  std::unique_ptr<sim::ArmLog> arm_;
 };
 
 // The Camera of one simulated pad. open() allocates buffer_count frame buffers, start() joins
