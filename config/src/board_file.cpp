@@ -646,11 +646,13 @@ std::string describe(const BoardConfig& b) {
       << (c.device.empty() ? "" : " " + c.device) << ", " << c.width << "x" << c.height << " @ "
       << c.fps << " fps, " << c.buffer_count << " buffers\n";
   }
-  if (b.uses_backend(CameraBackend::kSim)) {
+  if (b.uses_backend(CameraBackend::kSim) && !b.sim.plan.empty()) {
+    s << "  sim: " << b.sim.object << ", seed " << b.sim.seed << ", plan " << b.sim.plan
+      << " (one motion per recording)\n";
+  } else if (b.uses_backend(CameraBackend::kSim)) {
     s << "  sim: " << b.sim.object << ", motion " << b.sim.motion << " " << b.sim.magnitude << ", "
       << b.sim.regime << ", seed " << b.sim.seed << (b.sim.repeat ? ", repeat" : "")
       << (b.sim.realtime ? ", real time" : ", as fast as possible") << "\n";
-    if (!b.sim.plan.empty()) s << "  sim plan: " << b.sim.plan << " (one motion per recording)\n";
   }
   s << "  pipeline: " << (b.pipeline.method == dsp::FusionMethod::kJoint ? "joint" : "paper")
     << " fusion, proxy " << protocol::to_string(b.pipeline.velocity_proxy)

@@ -318,7 +318,8 @@ TEST(Board, SimPlanIsResolvedFromTheBoardFilesFolder) {
                           "/etc/b/board.toml", &b, &e))
       << e;
   EXPECT_EQ(b.sim.plan, "/srv/p.csv");
-  EXPECT_NE(describe(b).find("sim plan: /srv/p.csv (one motion per recording)"), std::string::npos)
+  EXPECT_NE(describe(b).find("sim: sphere, seed 1, plan /srv/p.csv (one motion per recording)"),
+            std::string::npos)
       << describe(b);
   const std::string empty = error_of(std::string(kMinimal) + "[sim]\nplan = \"\"\n");
   EXPECT_NE(empty.find("test.toml:5: key \"sim.plan\" must name a plan CSV file"),
