@@ -37,6 +37,8 @@ ADVICE = {
     "NOT_RECORDING": "the recording had already ended: see tacse3d's log (disk full?)",
     "DISK_ERROR": "the record dir is not writable or the disk is full: see tacse3d's log",
     "BUSY": "the gripper is busy: retry",
+    "OUT_OF_RANGE": "a simulated rig has played every motion of its [sim] plan: restart tacse3d "
+                    "(see its log)",
 }
 
 
@@ -51,10 +53,16 @@ def move(motion):
 # ---------------------------------------------------------------------------------------------
 
 
+# The simulator closes the pads in 0.4 s and lets the grasp settle for 0.1 s (docs/simulator.md).
+SIM_GRASP_S = 0.5
+
+
 def sim_move(scale):
-    """The simulator board plays its own scenario: only wait the motion's time."""
+    """The simulator board plays the motion itself ([sim] plan: the plan's next line; else its
+    own scenario): only wait for it, pads open, grasp, motion and hold."""
     def wait(motion):
-        time.sleep(scale * (motion["pads_open_s"] + motion["duration_s"] + motion["hold_s"]))
+        time.sleep(scale * (motion["pads_open_s"] + SIM_GRASP_S + motion["duration_s"] +
+                            motion["hold_s"]))
     return wait
 
 

@@ -184,6 +184,8 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
     rc.scene.repeat = board.sim.repeat;
     rc.scene.realtime = board.sim.realtime;
     rc.scene.finger_separation_mm = board.pipeline.finger_separation_m * 1e3;
+    rc.scene.plan = board.sim.plan;
+    rc.tcp_to_grasp = board.rig.tcp_to_grasp;
     const auto& s0 = board.sensors[0].enabled ? board.sensors[0] : board.sensors[1];
     rc.width = s0.width;
     rc.height = s0.height;
@@ -194,6 +196,7 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
       *error = board.origin + ": " + e;
       return nullptr;
     }
+    if (d->rig_->has_plan()) d->motion_ = d->rig_.get();
   }
   for (std::size_t s = 0; s < 2; ++s) {
     const config::SensorBoardConfig& sc = board.sensors[s];
@@ -650,6 +653,16 @@ void Daemon::close_recording() {
         static_cast<unsigned long long>(rs.rejected));
   }
   recorder_.reset();
+  if (motion_playing_) {
+    motion_playing_ = false;
+    const std::string me = motion_->stop_motion();
+    if (me.empty()) {
+      say(1, "recording %s: the simulated robot's log is %s/robot/gripper.csv",
+          recording_path_.c_str(), recording_path_.c_str());
+    } else {
+      say(0, "recording %s: the simulated robot's log: %s", recording_path_.c_str(), me.c_str());
+    }
+  }
 #endif
 }
 
@@ -663,6 +676,14 @@ void Daemon::service_recording() {
   RecordingMailbox::StartRequest req;
   if (recorder_ || !box.pending_start(&req)) return;
 #if TACSE3_HAVE_RECORDER
+  // The sim rig plays one plan motion per recording: none left, no recording (nothing created).
+  if (motion_ != nullptr) {
+    if (const std::string why = motion_->next_motion_problem(); !why.empty()) {
+      say(0, "START_RECORDING %u refused: %s", static_cast<unsigned>(req.number), why.c_str());
+      box.answer_start(nullptr, protocol::AckCode::kOutOfRange);
+      return;
+    }
+  }
   std::string message;
   const protocol::AckCode code =
       start_numbered_recording(board_.record.dir, req.number,
@@ -671,6 +692,10 @@ void Daemon::service_recording() {
   if (code == protocol::AckCode::kAck) {
     recording_path_ = numbered_recording_dir(board_.record.dir, req.number).string();
     recording_failure_reported_ = false;
+    if (motion_ != nullptr) {
+      motion_->start_motion(recording_path_);
+      motion_playing_ = true;
+    }
   }
   box.answer_start(recorder_.get(), code);
 #else

@@ -22,6 +22,7 @@ class LogChannel;
 }
 class SimRig;
 class SimCamera;
+class RecordedMotion;
 class GpioBackend;
 class GpioController;
 }  // namespace tacse3::hal
@@ -123,6 +124,10 @@ class Daemon {
   std::FILE* log_ = stderr;
 
   std::shared_ptr<hal::SimRig> rig_;
+  // The sim rig with a plan: it plays a motion per START_RECORDING (null: the cameras show what
+  // is in front of them). motion_playing_: one was started for the current recording.
+  hal::RecordedMotion* motion_ = nullptr;
+  bool motion_playing_ = false;
   std::array<std::unique_ptr<hal::Camera>, 2> cameras_;
   std::array<hal::SimCamera*, 2> sim_cameras_{};
   // Sources that are not paced to the wall clock (sim or replay with [sim] realtime = false)
