@@ -150,13 +150,13 @@ sim::SimStatus SimRig::render(sim::Sensor s, std::int64_t k, std::span<std::uint
   return sm.render(s, t, out, channels);
 }
 
-// The first grid frame neither pad has rendered: two periods from now (a pad renders at most one
-// frame ahead of its time), and after anything either pad has rendered.
+// The first grid frame neither pad has rendered: after anything either pad has rendered and, in
+// real time, two periods from now (a pad renders at most one frame ahead of its time).
 bool SimRig::append_segment(int motion) {
   const std::size_t n = segment_count_.load(std::memory_order_relaxed);
   if (n >= segment_capacity_) return false;
   std::int64_t k = segments_[n - 1].start_grid + 1;
-  if (const std::int64_t t0 = t0_ns(); t0 != 0) {
+  if (const std::int64_t t0 = t0_ns(); t0 != 0 && config_.scene.realtime) {
     const double now_k = std::ceil(static_cast<double>(monotonic_ns() - t0) * config_.fps * 1e-9);
     k = std::max(k, static_cast<std::int64_t>(now_k) + 2);
   }
