@@ -55,6 +55,9 @@ def move(motion):
 
 # The simulator closes the pads in 0.4 s and lets the grasp settle for 0.1 s (docs/simulator.md).
 SIM_GRASP_S = 0.5
+# A simulated rig opens the pads when the recording stops; the next tare must see them open,
+# and the frames reach the pipeline tens of milliseconds after they are taken.
+SIM_OPEN_S = 0.2
 
 
 def sim_move(scale):
@@ -151,7 +154,8 @@ def open_bus(a):
     return can.Bus(interface="socketcan", channel=a.channel)
 
 
-def session(client, plan, first, do_move):
+def session(client, plan, first, do_move, pause_s=0.0):
+    """pause_s: the wait after each stop, for the pads to be open before the next tare."""
     for i, motion in enumerate(plan):
         n = first + i
         client.tare()
@@ -164,6 +168,7 @@ def session(client, plan, first, do_move):
             client.stop_recording()
             raise
         client.stop_recording()
+        time.sleep(pause_s)
 
 
 def parse_args():
@@ -206,7 +211,10 @@ def main():
     client = tacse3.Client(logged, node=a.node, timeout=a.timeout)
     status = 0
     try:
-        session(client, plan, a.first, sim_move(a.duration_scale) if a.sim else move)
+        if a.sim:
+            session(client, plan, a.first, sim_move(a.duration_scale), SIM_OPEN_S)
+        else:
+            session(client, plan, a.first, move)
     except tacse3.NackError as e:
         print(f"error: {e}: {ADVICE.get(e.ack.result, 'see docs/can-protocol.md')}",
               file=sys.stderr)

@@ -639,6 +639,14 @@ RecorderConfig Daemon::recorder_config(double finger_separation_m) const {
 void Daemon::close_recording() {
 #if TACSE3_HAVE_RECORDER
   if (!recorder_) return;
+  // The simulated rig opens its pads at once (the next tare must see them open), before the
+  // writer drains; its robot's log covers the recording's last frame, which is already taken.
+  std::string motion_error;
+  const bool motion_stopped = motion_playing_;
+  if (motion_playing_) {
+    motion_playing_ = false;
+    motion_error = motion_->stop_motion();
+  }
   const std::string e = recorder_->close();
   const recording::StreamWriterStats rs = recorder_->stats();
   if (!e.empty()) {
@@ -653,15 +661,12 @@ void Daemon::close_recording() {
         static_cast<unsigned long long>(rs.rejected));
   }
   recorder_.reset();
-  if (motion_playing_) {
-    motion_playing_ = false;
-    const std::string me = motion_->stop_motion();
-    if (me.empty()) {
-      say(1, "recording %s: the simulated robot's log is %s/robot/gripper.csv",
-          recording_path_.c_str(), recording_path_.c_str());
-    } else {
-      say(0, "recording %s: the simulated robot's log: %s", recording_path_.c_str(), me.c_str());
-    }
+  if (motion_stopped && motion_error.empty()) {
+    say(1, "recording %s: the simulated robot's log is %s/robot/gripper.csv",
+        recording_path_.c_str(), recording_path_.c_str());
+  } else if (motion_stopped) {
+    say(0, "recording %s: the simulated robot's log: %s", recording_path_.c_str(),
+        motion_error.c_str());
   }
 #endif
 }

@@ -20,10 +20,6 @@ namespace {
 
 // A plan file is a few lines; this bounds what is read.
 constexpr std::size_t kMaxPlanBytes = 1 << 20;
-// At rest the pads stay open: a scenario whose approach lasts this long, played from its start
-// again every kRestWrapNs (the camera noise follows the time, so rest frames are not copies).
-constexpr double kRestApproachS = 60.0;
-constexpr std::int64_t kRestWrapNs = 50'000'000'000;
 // The robot logs from this long before the motion starts until this long after the pads open.
 constexpr std::int64_t kLogBeforeNs = 1'000'000'000;
 constexpr std::int64_t kLogAfterNs = 200'000'000;
@@ -89,21 +85,11 @@ bool SimRig::load_plan(const sim::SimConfig& base, std::string* error) {
     }
     plan_sims_.push_back(std::move(s));
   }
-  sim::SimConfig rest = base;
-  rest.scenario.approach_s = kRestApproachS;
-  rest.scenario.loop = false;
-  rest.scenario.release_s = 0.0;
-  rest_sim_ = sim::Simulator::create(rest, &e);
-  if (!rest_sim_) {
-    *error = "[sim] plan " + file + ": the rest scenario: " + e;
-    plan_sims_.clear();
-    return false;
-  }
   plan_file_ = file;
   // A start and a stop per motion, after the first rest.
   segment_capacity_ = 2 * plan_sims_.size() + 1;
   segments_ = std::make_unique<Segment[]>(segment_capacity_);
-  segments_[0] = Segment{-1, 0};
+  segments_[0] = Segment{-1, 0, 0};
   segment_count_.store(1, std::memory_order_release);
   for (auto& r : rendered_) r.store(-1, std::memory_order_relaxed);
   const std::array<double, 7>& g = config_.tcp_to_grasp;
@@ -139,10 +125,13 @@ sim::SimStatus SimRig::render(sim::Sensor s, std::int64_t k, std::span<std::uint
   rendered_[i].store(k, std::memory_order_release);
   const std::size_t j = segment_at(k);
   const Segment seg = segments_[j];
-  sim::Simulator& sm =
-      seg.motion < 0 ? *rest_sim_ : *plan_sims_[static_cast<std::size_t>(seg.motion)];
+  sim::Simulator& sm = *plan_sims_[static_cast<std::size_t>(seg.scene)];
   std::int64_t t = grid_time_ns(k) - grid_time_ns(seg.start_grid);
-  if (seg.motion < 0) t %= kRestWrapNs;
+  if (seg.motion < 0) {
+    // At rest: the scene's approach (pads open) over and over, so the camera noise goes on.
+    const auto open_ns = static_cast<std::int64_t>(sm.scenario().spec().approach_s * 1e9);
+    t = open_ns > 0 ? t % open_ns : 0;
+  }
   PadPlay& p = play_[i];
   if (p.segment != j || t < p.t_ns) sm.reset(s);  // a fresh grasp, or the rest starting over
   p.segment = j;
@@ -161,7 +150,10 @@ bool SimRig::append_segment(int motion) {
     k = std::max(k, static_cast<std::int64_t>(now_k) + 2);
   }
   for (const auto& r : rendered_) k = std::max(k, r.load(std::memory_order_acquire) + 1);
-  segments_[n] = Segment{motion, k};
+  // At rest the pads are open where the next motion grasps (a translation starts off centre).
+  const int scene =
+      motion >= 0 ? motion : static_cast<int>(std::min(next_motion_, plan_sims_.size() - 1));
+  segments_[n] = Segment{motion, scene, k};
   segment_count_.store(n + 1, std::memory_order_release);
   return true;
 }

@@ -128,9 +128,11 @@ class SimRig : public std::enable_shared_from_this<SimRig>, public RecordedMotio
   void restart_pad(sim::Sensor s) noexcept;
   bool load_plan(const sim::SimConfig& base, std::string* error);
 
-  // With a plan: from grid frame start_grid on the rig plays plan motion `motion` (-1: rest).
+  // With a plan: from grid frame start_grid on the rig plays plan motion `motion`, or rests
+  // (-1) with the pads open as in the approach of motion `scene`.
   struct Segment {
     int motion = -1;
+    int scene = 0;
     std::int64_t start_grid = 0;
   };
   std::size_t segment_at(std::int64_t k) const noexcept;
@@ -149,7 +151,6 @@ class SimRig : public std::enable_shared_from_this<SimRig>, public RecordedMotio
   // count with release) and read by the capture threads: no lock on the frame path.
   std::string plan_file_;
   std::vector<std::unique_ptr<sim::Simulator>> plan_sims_;
-  std::unique_ptr<sim::Simulator> rest_sim_;  // pads open, no contact
   std::unique_ptr<Segment[]> segments_;
   std::size_t segment_capacity_ = 0;
   std::atomic<std::size_t> segment_count_{0};
