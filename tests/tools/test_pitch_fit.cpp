@@ -3,8 +3,10 @@
 // simulator's pitch when the recordings' rig block claims another one.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -38,7 +40,44 @@ std::unique_ptr<tt::SimSource> stick_translation(const char* motion, double mm, 
   return s;
 }
 
+// The source with a robot's pose noise on its truth (rms 0.05 mm, as tacse3-truth's rebuilt
+// truth from an arm's log, docs/truth.md), in every row but the first (the reference).
+class NoisyTruthSource final : public tt::FrameSource {
+ public:
+  NoisyTruthSource(tt::FrameSource& inner, unsigned seed) : inner_(inner), info_(inner.info()) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> n(0.0, 0.05e-3 / std::sqrt(3.0));
+    for (std::size_t i = 1; i < info_.truth.size(); ++i) {
+      info_.truth[i].px += n(rng);
+      info_.truth[i].py += n(rng);
+      info_.truth[i].pz += n(rng);
+    }
+  }
+  const tt::SourceInfo& info() const noexcept override { return info_; }
+  std::string read(std::size_t index, std::array<const tacse3::dsp::FrameView*, 2>* v) override {
+    return inner_.read(index, v);
+  }
+
+ private:
+  tt::FrameSource& inner_;
+  tt::SourceInfo info_;
+};
+
 }  // namespace
+
+// A stick translation's truth with a robot's noise: the motion's start is found where the truth
+// leaves the start position for good, not at the first noisy row, and the pitch comes out.
+TEST(PitchFit, NoisyTruthFindsTheMotionsStart) {
+  constexpr double kTrue = 0.08;
+  auto tx = stick_translation("tx", 0.5, kTrue, 3);
+  ASSERT_TRUE(tx);
+  NoisyTruthSource noisy(*tx, 7);
+  tt::StickShift shift;
+  ASSERT_EQ(tt::measure_stick_shift(noisy, &shift), "");
+  EXPECT_GT(shift.shift_px.size(), 30u);
+  // Within 10 %: the noise of the truth rows (0.05 mm on 0.5 mm) enters the ratio.
+  EXPECT_NEAR(shift.pitch_mm() / kTrue, 1.0, 0.1);
+}
 
 TEST(PitchFit, RecoversTheRenderedPitchNotTheClaimedOne) {
   constexpr double kTrue = 0.08, kClaimed = 0.10;

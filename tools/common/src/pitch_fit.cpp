@@ -15,8 +15,11 @@ namespace tacse3::tools {
 namespace {
 
 constexpr double kQ16 = 65536.0;
-// The motion starts at the first frame whose translation reaches this fraction of the peak.
+// The motion starts after the last frame within this fraction of the peak of the start position,
+// before the translation reaches kHalfway of it. Searched back from there, so that a robot log's
+// pose noise (tenths of the stick translation) before the motion is not taken for its start.
 constexpr double kStartFraction = 0.05;
+constexpr double kHalfway = 0.5;
 // Fewest contact points a frame's mean displacement is taken over (one grid cell's neighbours).
 constexpr int kMinPoints = 9;
 
@@ -66,8 +69,10 @@ std::string measure_stick_shift(FrameSource& source, StickShift* out) {
   const std::vector<Eigen::Vector2d> xy = truth_xy_mm(info);
   double peak = 0.0;
   for (const auto& v : xy) peak = std::max(peak, v.norm());
-  std::size_t start = 0;
-  while (start + 1 < xy.size() && xy[start + 1].norm() < kStartFraction * peak) ++start;
+  std::size_t half = 0;
+  while (half + 1 < xy.size() && xy[half].norm() < kHalfway * peak) ++half;
+  std::size_t start = half;
+  while (start > 0 && xy[start].norm() >= kStartFraction * peak) --start;
   std::array<StartField, 2> ref{};
   ReplaySinks sinks;
   sinks.on_frame = [&](std::size_t i, const FrameResult&, const Replayer& engine) {
