@@ -80,7 +80,7 @@ def main():
     log = open(args.screenshot + ".tacse3d.log", "w")
     daemon = subprocess.Popen([args.tacse3d, "--board", board, "--calibration",
                                args.calibration, "--can-log", os.devnull, "--http",
-                               f"127.0.0.1:{port}", "--seconds", "60"],
+                               f"127.0.0.1:{port}", "--seconds", "120"],
                               stdout=subprocess.DEVNULL, stderr=log)
     browser = None
     try:
@@ -145,7 +145,7 @@ def main():
         page_pose = "return [window.tacse3.last().cycle, window.tacse3.last().pose.q]"
         assert js("return document.getElementById('controls-off').hidden"), "controls shown off"
         before = wait_for("the object to turn 8 degrees", lambda: (lambda cq: cq if angle_of(
-            cq[1]) >= 8 else None)(js(page_pose)), 20)
+            cq[1]) >= 8 else None)(js(page_pose)), 60)
         # The screenshot with the object turned, the 3D view showing it.
         browser.save_screenshot(args.screenshot)
         browser.find_element("id", "cmd-tare").click()
