@@ -9,6 +9,7 @@
 
 #include "replay_view.hpp"
 #include "tacse3/config/calibration_file.hpp"
+#include "tacse3/config/listen_address.hpp"
 #include "tacse3/fileio/file_io.hpp"
 #include "tacse3/tools/can_log.hpp"
 #include "tacse3/tools/cli.hpp"
@@ -182,7 +183,7 @@ int run(int argc, char** argv) {
       ->check(CLI::Validator(
           [&view_at](std::string& text) {
             std::string e;
-            return tt::ReplayView::parse(text, &view_at, &e) ? std::string() : e;
+            return tacse3::config::parse_listen_address(text, &view_at, &e) ? std::string() : e;
           },
           "[ADDR:]PORT"));
   if (const int rc = tt::parse_command_line(app, argc, argv); rc >= 0) return rc;

@@ -5,7 +5,6 @@
 #include <signal.h>
 
 #include <cstdio>
-#include <filesystem>
 
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/protocol/types.hpp"
@@ -45,14 +44,6 @@ void fill_scalars(std::size_t index, const FrameResult& r, bool calibrated,
   v->confidence = r.estimate_valid ? r.confidence : 0.0;
 }
 
-// The page: installed (<exe_dir>/../share/tacse3/viewer) or this build tree's.
-std::filesystem::path page_folder() {
-  std::filesystem::path p = viewer::find_viewer_assets(config::executable_dir());
-  if (p.empty() && std::filesystem::is_regular_file(TACSE3_BUILD_VIEWER_DIR "/index.html"))
-    p = TACSE3_BUILD_VIEWER_DIR;
-  return p;
-}
-
 }  // namespace
 
 struct ReplayView::Impl {
@@ -68,10 +59,6 @@ struct ReplayView::Impl {
 ReplayView::ReplayView(const SourceInfo& info, bool calibrated)
     : impl_(std::make_unique<Impl>(info, calibrated)) {}
 ReplayView::~ReplayView() = default;
-
-bool ReplayView::parse(const std::string& text, config::ListenAddress* out, std::string* error) {
-  return config::parse_listen_address(text, out, error);
-}
 
 const char* ReplayView::unavailable() noexcept {
   if (TACSE3_HAVE_VIEWER != 0) return nullptr;
@@ -106,7 +93,7 @@ std::string ReplayView::serve(const config::ListenAddress& listen, const std::st
 #if TACSE3_HAVE_VIEWER
   viewer::ViewServerConfig c;
   c.listen = listen;
-  c.assets = page_folder();
+  c.assets = viewer::find_viewer_assets(config::executable_dir());
   if (c.assets.empty()) return "the viewer's page is not installed (build tacse3_viewer_assets)";
   viewer::ViewInfo info;
   info.version = kVersion;

@@ -20,8 +20,6 @@ class ReplayView {
   ReplayView(const ReplayView&) = delete;
   ReplayView& operator=(const ReplayView&) = delete;
 
-  // --view's text: "PORT" or "ADDR:PORT". false with *error (a usage error).
-  static bool parse(const std::string& text, config::ListenAddress* out, std::string* error);
   // Why this build cannot serve (built without cpp-httplib, libturbojpeg or nlohmann-json);
   // null when it can.
   static const char* unavailable() noexcept;

@@ -613,10 +613,14 @@ std::string RecordedViews::frames_json() const {
 }
 
 std::filesystem::path find_viewer_assets(const std::filesystem::path& exe_dir) {
-  const std::filesystem::path dir = exe_dir / ".." / "share" / "tacse3" / "viewer";
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(dir / "index.html", ec)) return {};
-  return std::filesystem::weakly_canonical(dir, ec);
+  for (const std::filesystem::path& dir : {exe_dir / ".." / "share" / "tacse3" / "viewer",
+                                           std::filesystem::path(TACSE3_BUILD_VIEWER_DIR)}) {
+    if (std::filesystem::is_regular_file(dir / "index.html", ec)) {
+      return std::filesystem::weakly_canonical(dir, ec);
+    }
+  }
+  return {};
 }
 
 ViewServer::ViewServer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

@@ -36,8 +36,9 @@ struct ViewServerConfig {
 // message) for anything but the documented forms.
 bool parse_web_command(const std::string& body, protocol::Command* command, std::string* error);
 
-// The viewer assets folder: <exe_dir>/../share/tacse3/viewer (the package's and the build
-// tree's). Empty when it holds no index.html.
+// The viewer assets folder: <exe_dir>/../share/tacse3/viewer (the package's, and the build
+// tree's for a program one folder deep), else the build tree's own. Empty when none holds an
+// index.html.
 std::filesystem::path find_viewer_assets(const std::filesystem::path& exe_dir);
 
 struct Rendered;
