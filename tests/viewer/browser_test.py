@@ -12,13 +12,13 @@ Exit 77 (ctest: skipped) with a message when Chromium, its driver or selenium is
 import argparse
 import math
 import os
-import shutil
 import subprocess
 import sys
 import time
 
 from pose3d_check import check_pose3d
-from viewer_support import SKIP, free_port, get_json, wait_for
+from viewer_support import (SKIP, chromium_missing, free_port, get_json, headless_chromium,
+                            wait_for)
 
 # Standard deviation of a canvas's luma (the image with its overlays), computed in the page.
 CANVAS_SD = """
@@ -53,17 +53,9 @@ def main():
     ap.add_argument("--screenshot", required=True)
     args = ap.parse_args()
 
-    chromium = shutil.which("chromium")
-    driver = shutil.which("chromedriver")
-    try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.options import Options
-        from selenium.webdriver.chrome.service import Service
-    except ImportError:
-        webdriver = None
-    if not chromium or not driver or webdriver is None:
-        print("browser test skipped: needs Debian's chromium, chromium-driver and python3-selenium "
-              "(scripts/setup.sh installs them)")
+    missing = chromium_missing()
+    if missing:
+        print(missing)
         return SKIP
 
     # The sim board looping its scenario, so the plots keep moving however long the browser takes.
@@ -86,12 +78,7 @@ def main():
     try:
         wait_for("/api/state", lambda: get_json(base + "/api/state"), 15)
 
-        opts = Options()
-        opts.binary_location = chromium
-        for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1500,1400",
-                  "--disable-dev-shm-usage"):
-            opts.add_argument(a)
-        browser = webdriver.Chrome(service=Service(driver), options=opts)
+        browser = headless_chromium(1400)
         browser.get(base + "/")
         js = browser.execute_script
 

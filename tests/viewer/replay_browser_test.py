@@ -15,13 +15,13 @@ import csv
 import json
 import math
 import os
-import shutil
 import sys
 import time
 import urllib.request
 
 from pose3d_check import check_pose3d
-from viewer_support import SKIP, served_recording, wait_for
+from viewer_support import (SKIP, chromium_missing, headless_chromium, served_recording,
+                            wait_for)
 
 
 def rotation_vector_deg(q):
@@ -34,16 +34,6 @@ def rotation_vector_deg(q):
         return [0.0, 0.0, 0.0]
     angle = 2 * math.degrees(math.atan2(s, w))
     return [angle * x / s, angle * y / s, angle * z / s]
-
-
-def selenium_or_none():
-    try:
-        from selenium import webdriver
-        from selenium.webdriver.chrome.options import Options
-        from selenium.webdriver.chrome.service import Service
-        return webdriver, Options, Service
-    except ImportError:
-        return None
 
 
 def check_scrub(js, base, frames, mid):
@@ -134,12 +124,10 @@ def main():
     ap.add_argument("--screenshot", required=True)
     args = ap.parse_args()
 
-    chromium, driver, sel = shutil.which("chromium"), shutil.which("chromedriver"), selenium_or_none()
-    if not chromium or not driver or sel is None:
-        print("browser test skipped: needs Debian's chromium, chromium-driver and python3-selenium "
-              "(scripts/setup.sh installs them)")
+    missing = chromium_missing()
+    if missing:
+        print(missing)
         return SKIP
-    webdriver, Options, Service = sel
 
     with served_recording(args.sim, args.replay, args.screenshot + ".replay.log",
                           "tacse3-replay-view-") as (rec, base, info):
@@ -148,12 +136,7 @@ def main():
         states = frames["states"]
         assert frames["frames"] == len(states) == 180, f"{frames['frames']} frames served"
 
-        opts = Options()
-        opts.binary_location = chromium
-        for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1500,1600",
-                  "--disable-dev-shm-usage"):
-            opts.add_argument(a)
-        browser = webdriver.Chrome(service=Service(driver), options=opts)
+        browser = headless_chromium(1600)
         try:
             browser.get(base + "/")
             js = browser.execute_script

@@ -30,6 +30,31 @@ def wait_for(what, fn, timeout_s, poll_s=0.05):
     raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
 
 
+def chromium_missing():
+    """Why headless Chromium cannot run here (to print before exiting SKIP), or None."""
+    try:
+        import selenium  # noqa: F401
+    except ImportError:
+        selenium = None
+    if shutil.which("chromium") and shutil.which("chromedriver") and selenium is not None:
+        return None
+    return ("browser test skipped: needs Debian's chromium, chromium-driver and python3-selenium "
+            "(scripts/setup.sh installs them)")
+
+
+def headless_chromium(window_height):
+    """Debian's chromium under chromedriver, headless, 1500 px wide."""
+    from selenium import webdriver
+    from selenium.webdriver.chrome.options import Options
+    from selenium.webdriver.chrome.service import Service
+    opts = Options()
+    opts.binary_location = shutil.which("chromium")
+    for a in ("--headless=new", "--no-sandbox", "--disable-gpu",
+              f"--window-size=1500,{window_height}", "--disable-dev-shm-usage"):
+        opts.add_argument(a)
+    return webdriver.Chrome(service=Service(shutil.which("chromedriver")), options=opts)
+
+
 def get_json(url, timeout_s=1):
     """The endpoint's JSON, or None while the server is not up."""
     try:
