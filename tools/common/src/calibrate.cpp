@@ -12,12 +12,14 @@
 #include <cstdio>
 #include <ctime>
 #include <iterator>
+#include <limits>
 #include <mutex>
 #include <numbers>
 #include <thread>
 
 #include "tacse3/dsp/calibration_fields.hpp"
 #include "tacse3/tools/calibration_check.hpp"
+#include "tacse3/tools/contact_area.hpp"
 #include "tacse3/tools/contact_noise.hpp"
 #include "tacse3/tools/progress.hpp"
 
@@ -69,9 +71,26 @@ struct RunOutput {
   std::vector<Eigen::Vector3d> omega;  // per-frame ω̄ (kept when asked for)
 };
 
+// Each pad's filter(f^z) of the engine's last frame, NaN where not valid.
+void add_fz_grids(const Replayer& engine, const std::array<const dsp::FrameView*, 2>& views,
+                  PreMotionFz* pre) {
+  for (std::size_t s = 0; s < 2; ++s) {
+    const dsp::SensorFields& f = engine.pipeline().sensor(static_cast<dsp::SensorSlot>(s)).fields();
+    FzGrid g;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      g[i] = views[s] != nullptr && f.smoothed_valid.v[i] != 0
+                 ? static_cast<float>(f.contact.fz_filtered.v[i] * kQ16)
+                 : std::numeric_limits<float>::quiet_NaN();
+    }
+    pre->add(s, g);
+  }
+}
+
+// `pre`, when given, receives both pads' f^z of the frames before `pre_frames`.
 std::string run_pass(FrameSource& src, const std::vector<ReplayOptions>& configs,
                      std::atomic<std::int64_t>* done, PreContactNoise* noise,
-                     std::vector<RunOutput>* out, bool keep_omega = false) {
+                     std::vector<RunOutput>* out, bool keep_omega = false,
+                     PreMotionFz* pre = nullptr, std::size_t pre_frames = 0) {
   const SourceInfo& info = src.info();
   std::vector<std::unique_ptr<Replayer>> engines;
   for (const auto& c : configs) {
@@ -102,6 +121,7 @@ std::string run_pass(FrameSource& src, const std::vector<ReplayOptions>& configs
       }
       noise->add_frame(i, fz);
     }
+    if (pre != nullptr && i < pre_frames) add_fz_grids(*engines[0], views, pre);
     if (done != nullptr) ++*done;
   }
   return {};
@@ -446,6 +466,49 @@ std::string bound_problem(const std::string& field, double wanted, double lo, do
   return o;
 }
 
+// The first frame at or after the truth's motion start.
+std::size_t motion_frame(const SourceInfo& in) {
+  const std::int64_t start_ns = motion_start_ns(in.truth);
+  std::size_t i = 0;
+  while (i < in.frame_count() && in.t_ns[i] < start_ns) ++i;
+  return i;
+}
+
+// Stage 1, the area: at tau_on the noise still makes small components now and then (f^z is
+// smoothed, so its excursions span several grid points, and its tails are heavier than a
+// Gaussian's). contact_min_area_cells is set one above the largest component in any recording's
+// frames before the grasp (never below the starting value), so none of them would start a
+// contact. A pad whose contact at the motion start is no larger cannot be told from its noise:
+// that is a problem, named per recording.
+void fit_contact_area(const std::vector<FrameSource*>& sources, const std::vector<PreMotionFz>& pre,
+                      int start_area, CalibrateReport* rep) {
+  int largest = 0;
+  std::size_t quiet = 0;
+  std::vector<NoiseComponents> nc(sources.size());
+  for (std::size_t r = 0; r < sources.size(); ++r) {
+    nc[r] = noise_components(pre[r], rep->contact_tau_on);
+    largest = std::max(largest, nc[r].largest);
+    quiet += nc[r].quiet_frames;
+  }
+  rep->noise_largest_component = largest;
+  rep->noise_component_frames = quiet;
+  rep->contact_min_area_cells = std::max(start_area, largest + 1);
+  for (std::size_t r = 0; r < sources.size(); ++r) {
+    for (std::size_t p = 0; p < 2; ++p) {
+      const int cells = nc[r].contact_cells[p];
+      if (cells == 0 || cells >= rep->contact_min_area_cells) continue;
+      char b[320];
+      std::snprintf(b, sizeof b,
+                    "%s: the %s pad's contact at the motion start covers %d grid point(s), fewer "
+                    "than contact_min_area_cells %d (the noise before contact made components of "
+                    "%d): grasp harder or with a larger object, or check the pad's lighting",
+                    sources[r]->info().name.c_str(), p == 0 ? "left" : "right", cells,
+                    rep->contact_min_area_cells, largest);
+      rep->problems.push_back(b);
+    }
+  }
+}
+
 // Stage 1: one run with the starting calibration feeds every recording's filter(f^z) to a
 // PreContactNoise. A recording gives a noise estimate when its contact onset comes before the
 // truth starts to move (the grasp closes on a still object); one whose first frames are already
@@ -458,12 +521,15 @@ std::string fit_contact_threshold(const std::vector<FrameSource*>& sources,
                                   CalibrateReport* rep) {
   const std::size_t n = sources.size();
   std::vector<PreContactNoise> noise(n);
+  std::vector<PreMotionFz> pre(n);
+  std::vector<std::size_t> motion_frames(n);
+  for (std::size_t r = 0; r < n; ++r) motion_frames[r] = motion_frame(sources[r]->info());
   std::string err =
       run_stage(sources, opt.jobs, opt.progress, "calibrate 1/4", [&](std::size_t r, auto* done) {
         std::vector<ReplayOptions> cfg(1);
         cfg[0].calibration = base;
         std::vector<RunOutput> out;
-        return run_pass(*sources[r], cfg, done, &noise[r], &out);
+        return run_pass(*sources[r], cfg, done, &noise[r], &out, false, &pre[r], motion_frames[r]);
       });
   if (!err.empty()) return err;
   std::vector<double> sigmas;
@@ -471,9 +537,7 @@ std::string fit_contact_threshold(const std::vector<FrameSource*>& sources,
   for (std::size_t r = 0; r < n; ++r) {
     const SourceInfo& in = sources[r]->info();
     RecordingFit& f = rep->recordings[r];
-    const std::int64_t start_ns = motion_start_ns(in.truth);
-    std::size_t motion_frame = 0;
-    while (motion_frame < in.frame_count() && in.t_ns[motion_frame] < start_ns) ++motion_frame;
+    const std::size_t motion_frame = motion_frames[r];
     const PreContactNoise& z = noise[r];
     f.quiet_frames = z.quiet_frames();
     if (z.onset_found()) f.contact_onset_frame = static_cast<std::int64_t>(z.onset_frame());
@@ -507,6 +571,7 @@ std::string fit_contact_threshold(const std::vector<FrameSource*>& sources,
   }
   rep->contact_tau_on = round_sig(PreContactNoise::kOnsetSigma * sigma, 3);
   rep->contact_tau_off = round_sig(0.5 * PreContactNoise::kOnsetSigma * sigma, 3);
+  fit_contact_area(sources, pre, base.sensor[0].contact_min_area_cells, rep);
   return {};
 }
 
@@ -573,6 +638,7 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
   for (auto& c : base.sensor) {
     c.contact_tau_on = rep.contact_tau_on;
     c.contact_tau_off = rep.contact_tau_off;
+    c.contact_min_area_cells = rep.contact_min_area_cells;
   }
 
   // ---- stage 1: one run per proxy and shear component -------------------------------------
@@ -1000,6 +1066,11 @@ std::string format_report(const CalibrateReport& rep) {
                 "contact threshold: f^z noise sigma %.4g before contact (median of %d "
                 "recording(s)) -> contact_tau_on %.4g, contact_tau_off %.4g\n",
                 rep.fz_noise_sigma, noisy, c.contact_tau_on, c.contact_tau_off);
+  o += line;
+  std::snprintf(line, sizeof(line),
+                "contact area: the noise's largest component over tau_on before contact %d grid "
+                "point(s) (%zu quiet frame(s)) -> contact_min_area_cells %d\n",
+                rep.noise_largest_component, rep.noise_component_frames, c.contact_min_area_cells);
   o += line;
   std::snprintf(line, sizeof(line),
                 "shear gains (d, r, k) = (%.4g, %.4g, %.4g); c_velocity %.4g m/s per unit "

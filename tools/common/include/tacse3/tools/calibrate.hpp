@@ -58,6 +58,11 @@ struct CalibrateReport {
   std::vector<RecordingFit> recordings;
   double fz_noise_sigma = 0.0;  // median over the recordings of their pre-contact f^z σ
   double contact_tau_on = 0.0, contact_tau_off = 0.0;
+  // The noise's largest component over contact_tau_on in the frames before contact, the frames
+  // that was over, and the minimum area fitted from it (contact_area.hpp).
+  int noise_largest_component = 0;
+  std::size_t noise_component_frames = 0;
+  int contact_min_area_cells = 0;
   std::array<double, 3> shear_gains{0.0, 1.0, 1.0};  // fitted (d, r, k), max = 1
   std::array<int, 2> recordings_per_mode{0, 0};      // [velocity, displacement]
   int iterations = 0;
