@@ -8,8 +8,8 @@
                                layers above
     firmware, tools            wire everything together (neither includes the other)
 
-The fixed-point dsp path also stays pure: it may include only the standard and Eigen headers in
-DSP_STD_ALLOWED (no I/O, no threads, no heap containers).
+The fixed-point dsp path also stays pure: it may include only the standard, Eigen and Highway
+(SIMD) headers in DSP_STD_ALLOWED (no I/O, no threads, no heap containers).
 
 Usage: scripts/check-includes.py [ROOT]     exit 0 when clean, 1 with one line per violation.
 """
@@ -55,6 +55,7 @@ DSP_STD_ALLOWED = {
     "algorithm", "array", "bit", "cmath", "cstddef", "cstdint", "cstring", "limits", "numbers",
     "type_traits", "utility", "Eigen/Core", "Eigen/Geometry", "Eigen/Eigenvalues",
     "emmintrin.h", "arm_neon.h",
+    "hwy/highway.h", "hwy/foreach_target.h", "hwy/targets.h",
 }
 
 SOURCE_SUFFIXES = {".hpp", ".cpp", ".h", ".c"}

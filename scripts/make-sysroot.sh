@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
-# tacse3: unpack the target's libraries (gpiod, turbojpeg, libcamera, spng, systemd) into build/sysroot/<arch>.
+# tacse3: unpack the target's libraries (gpiod, turbojpeg, libcamera, spng, systemd, hwy) into build/sysroot/<arch>.
 #
 # Usage: scripts/make-sysroot.sh <aarch64|arm64|armhf> [--no-libcamera]
 #
@@ -41,6 +41,8 @@ TOP+=(libspng-dev libspng0)
 TOP+=(libcpp-httplib-dev libcpp-httplib0.11)
 # The daemon's sd_notify (READY=1, WATCHDOG=1).
 TOP+=(libsystemd-dev libsystemd0)
+# The dsp SIMD kernels: Google Highway's headers (Arm builds dispatch at compile time).
+TOP+=(libhwy-dev)
 if [ "$WITH_LIBCAMERA" = 1 ]; then TOP+=(libcamera-dev libcamera0.0.3); fi
 # Provided by the cross toolchain (g++-<triple>): never mix a second copy into the sysroot, and
 # never follow their dependencies (libspng-dev -> zlib1g-dev -> libc6-dev would otherwise drag in
@@ -162,6 +164,10 @@ for lib in libgpiodcxx.so libturbojpeg.so libspng.so libsystemd.so libcpp-httpli
     missing=1
   fi
 done
+if [ ! -e "$SYSROOT/usr/include/hwy/highway.h" ]; then
+  echo "make-sysroot: hwy/highway.h (libhwy-dev) missing from $SYSROOT/usr/include" >&2
+  missing=1
+fi
 if [ "$missing" = 1 ]; then
   echo "make-sysroot: incomplete sysroot left in $SYSROOT; $FINAL is unchanged" >&2
   exit 1

@@ -20,6 +20,8 @@ PACKAGES=(
   # libraries
   libeigen3-dev googletest libgtest-dev libbenchmark-dev
   libtomlplusplus-dev libcli11-dev libspng-dev libpng-dev nlohmann-json3-dev
+  # the dsp stages' SIMD kernels (Google Highway; docs/performance.md says why)
+  libhwy-dev
   # OpenCV's DIS optical flow, for the bench-only comparison tacse3_bench_vs_dis
   libopencv-video-dev
   # hardware backends: MJPEG decode, GPIO, libcamera

@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # tacse3: the test command. Builds and runs the host tests, the ASan+UBSan build and the aarch64
-# build under qemu-user (the host presets include the Python package's tests), then builds and
+# build under qemu-user (the host presets include the Python package's tests) and the armhf SIMD
+# equivalence test under qemu-arm, then builds and
 # checks the arm64/armhf .deb packages, the controller SDK .debs (amd64/arm64/armhf, with programs
 # built against them) and the Python wheel and .deb, runs the bounded fuzzers of
 # every input parser (fuzz/run.sh) and the real-driver VM suite (tests/vm: SocketCAN, V4L2,
 # libcamera, GPIO in
 # qemu-system guests). Exits non-zero on any failure.
-# Skips: TACSE3_SKIP_PACKAGE=1, TACSE3_SKIP_FUZZ=1, TACSE3_SKIP_VM=1.
+# Skips: TACSE3_SKIP_PACKAGE=1, TACSE3_SKIP_FUZZ=1, TACSE3_SKIP_VM=1, TACSE3_SKIP_ARMHF_SIMD=1.
 # Usage: scripts/test.sh [preset ...]      (default: host host-sanitize aarch64)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,6 +35,16 @@ for preset in "${presets[@]}"; do
   ctest --preset "$preset" -j "$JOBS"
   summary+=("$preset: ok")
 done
+
+# The armhf build's SIMD kernels (NEON on ARMv7) against their scalar path under qemu-arm, when
+# the full armhf preset did not run: one test program, so the suite stays short.
+if [[ " ${presets[*]} " != *" armhf "* ]] && [ "${TACSE3_SKIP_ARMHF_SIMD:-0}" != "1" ]; then
+  echo "=== [armhf] SIMD equivalence (dsp_test_simd) ==="
+  cmake --preset armhf >/dev/null
+  cmake --build --preset armhf -j "$JOBS" --target dsp_test_simd
+  ctest --preset armhf -j "$JOBS" -R '^Simd'
+  summary+=("armhf SIMD: ok")
+fi
 
 # The arm64 and armhf .deb packages, built and checked against tests/packaging/contents.txt, the
 # SDK packages (scripts/package-sdk.sh, tests/packaging/contents-sdk.txt and test_sdk.sh), and

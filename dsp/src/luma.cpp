@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "luma_kernels.hpp"
+
 namespace tacse3::dsp {
 namespace {
 
@@ -15,8 +17,8 @@ bool known_format(PixelFormat f) noexcept {
   return f == PixelFormat::kRgb888 || f == PixelFormat::kYuyv || f == PixelFormat::kGrey;
 }
 
-// One output row from two input rows. Each kernel is a plain counted loop over contiguous
-// bytes so that g++ -O2 can vectorise it.
+// The scalar path: one output row from two input rows. Each kernel is a plain counted loop over
+// contiguous bytes so that g++ -O2 can vectorise it.
 void grey_row(const std::uint8_t* __restrict r0, const std::uint8_t* __restrict r1,
               std::uint16_t* __restrict out) noexcept {
   for (int x = 0; x < kWorkWidth; ++x) {
@@ -61,6 +63,11 @@ void rgb_row(const std::uint8_t* __restrict r0, const std::uint8_t* __restrict r
   }
 }
 
+std::size_t frame_stride(const FrameView& in) noexcept {
+  return static_cast<std::size_t>(in.stride_bytes == 0 ? packed_row_bytes(in.format)
+                                                       : in.stride_bytes);
+}
+
 }  // namespace
 
 Status check_frame(const FrameView& in) noexcept {
@@ -80,8 +87,14 @@ Status check_frame(const FrameView& in) noexcept {
 Status frame_to_work_image(const FrameView& in, WorkImage& out) noexcept {
   const Status s = check_frame(in);
   if (s != Status::kOk) return s;
-  const std::size_t stride = static_cast<std::size_t>(
-      in.stride_bytes == 0 ? packed_row_bytes(in.format) : in.stride_bytes);
+  detail::luma_image_simd(in.format, in.data, frame_stride(in), out.px.data());
+  return Status::kOk;
+}
+
+Status frame_to_work_image_scalar(const FrameView& in, WorkImage& out) noexcept {
+  const Status s = check_frame(in);
+  if (s != Status::kOk) return s;
+  const std::size_t stride = frame_stride(in);
   for (int y = 0; y < kWorkHeight; ++y) {
     const std::uint8_t* r0 = in.data + stride * static_cast<std::size_t>(2 * y);
     const std::uint8_t* r1 = r0 + stride;

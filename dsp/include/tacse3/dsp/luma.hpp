@@ -46,7 +46,10 @@ Status check_frame(const FrameView& in) noexcept;
 //    U8.2 against the real-valued sum). The weighted sum is at most 256 * 1020 = 261120 (int32).
 //    The result never exceeds 1020, so nothing saturates.
 //  - YUYV uses only the Y bytes; chroma is ignored.
-// On any error status `out` is left untouched.
+// On any error status `out` is left untouched. Runs on the best SIMD target (simd.hpp).
 Status frame_to_work_image(const FrameView& in, WorkImage& out) noexcept;
+
+// The scalar path of frame_to_work_image: the same result, bit for bit (tests, benchmarks).
+Status frame_to_work_image_scalar(const FrameView& in, WorkImage& out) noexcept;
 
 }  // namespace tacse3::dsp
