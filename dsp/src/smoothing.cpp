@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "smoothing_kernels.hpp"
 #include "tacse3/dsp/fixed.hpp"
 
 namespace tacse3::dsp {
@@ -19,6 +20,25 @@ std::int64_t div_round_half_up(std::int64_t a, std::int64_t b) noexcept {
   std::int64_t q = num / den;
   if (num % den != 0 && num < 0) --q;  // C++ truncates towards zero; we want floor
   return q;
+}
+
+// out(p) = numerator / weight, or invalid below the support threshold: the last step of both paths.
+void normalise(std::int64_t nx, std::int64_t ny, std::int64_t w, std::int64_t min_weight,
+               VectorField& out, GridMask& out_valid, std::size_t p) noexcept {
+  if (w == kFullWeight) {
+    // Whole support valid and inside the grid: the division is a rounding shift.
+    out.x.v[p] = sat32(rshift_round(nx, 2 * FlowSmoother::kTapFrac));
+    out.y.v[p] = sat32(rshift_round(ny, 2 * FlowSmoother::kTapFrac));
+    out_valid.v[p] = 1;
+  } else if (w >= min_weight) {
+    out.x.v[p] = sat32(div_round_half_up(nx, w));
+    out.y.v[p] = sat32(div_round_half_up(ny, w));
+    out_valid.v[p] = 1;
+  } else {
+    out.x.v[p] = 0;
+    out.y.v[p] = 0;
+    out_valid.v[p] = 0;
+  }
 }
 
 }  // namespace
@@ -176,6 +196,50 @@ void column_pass(const std::int32_t* g, int r, int y, const std::int64_t* rx,
 
 void FlowSmoother::apply(const VectorField& in, const GridMask& valid, VectorField& out,
                          GridMask& out_valid) noexcept {
+  bool all_valid = true;
+  for (std::size_t p = 0; p < kGridCount; ++p) all_valid = all_valid && valid.v[p] != 0;
+  const bool weights = !all_valid;  // as in apply_scalar
+  constexpr int kPad = kMaxRadius;
+  for (int y = 0; y < kGridHeight; ++y) {
+    for (int x = 0; x < kGridWidth; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y * kGridWidth + x);
+      const std::size_t q = static_cast<std::size_t>(y * kPadWidth + kPad + x);
+      const bool ok = valid.v[p] != 0;
+      pad_x_[q] = ok ? in.x.v[p] : 0;
+      pad_y_[q] = ok ? in.y.v[p] : 0;
+      pad_w_[q] = ok ? 1 : 0;
+    }
+  }
+  detail::SmoothingSums s;
+  s.taps = taps_.data();
+  s.radius = radius_;
+  s.weights = weights;
+  s.in_x = pad_x_.data();
+  s.in_y = pad_y_.data();
+  s.in_w = pad_w_.data();
+  s.hi_x = hi_x_.data();
+  s.lo_x = lo_x_.data();
+  s.hi_y = hi_y_.data();
+  s.lo_y = lo_y_.data();
+  s.row_w = sum_w_.data();
+  s.num_x = row_x_.data();
+  s.num_y = row_y_.data();
+  s.num_w = row_w_.data();
+  detail::smoothing_sums_simd(s);
+  for (int y = 0; y < kGridHeight; ++y) {
+    for (int x = 0; x < kGridWidth; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y * kGridWidth + x);
+      const std::int64_t w =
+          weights ? row_w_[p]
+                  : static_cast<std::int64_t>(edge_wx_[static_cast<std::size_t>(x)]) *
+                        edge_wy_[static_cast<std::size_t>(y)];
+      normalise(row_x_[p], row_y_[p], w, min_weight_, out, out_valid, p);
+    }
+  }
+}
+
+void FlowSmoother::apply_scalar(const VectorField& in, const GridMask& valid, VectorField& out,
+                                GridMask& out_valid) noexcept {
   const int r = radius_;
   const std::int32_t* g = taps_.data();
 
@@ -226,20 +290,7 @@ void FlowSmoother::apply(const VectorField& in, const GridMask& valid, VectorFie
       const std::int64_t w =
           weights ? wt[c]
                   : static_cast<std::int64_t>(edge_wx_[c]) * edge_wy_[static_cast<std::size_t>(y)];
-      if (w == kFullWeight) {
-        // Whole support valid and inside the grid: the division is a rounding shift.
-        out.x.v[p] = sat32(rshift_round(nx[c], 2 * kTapFrac));
-        out.y.v[p] = sat32(rshift_round(ny[c], 2 * kTapFrac));
-        out_valid.v[p] = 1;
-      } else if (w >= min_weight_) {
-        out.x.v[p] = sat32(div_round_half_up(nx[c], w));
-        out.y.v[p] = sat32(div_round_half_up(ny[c], w));
-        out_valid.v[p] = 1;
-      } else {
-        out.x.v[p] = 0;
-        out.y.v[p] = 0;
-        out_valid.v[p] = 0;
-      }
+      normalise(nx[c], ny[c], w, min_weight_, out, out_valid, p);
     }
   }
 }

@@ -11,6 +11,7 @@
 
 #include "tacse3/dsp/luma.hpp"
 #include "tacse3/dsp/simd.hpp"
+#include "tacse3/dsp/smoothing.hpp"
 
 namespace tacse3::dsp {
 namespace {
@@ -122,6 +123,96 @@ TEST(SimdLuma, SaturatedAndAlternatingFramesEqualScalar) {
       expect_luma_equal(
           make_frame(f, 3, [](std::size_t i) { return static_cast<std::uint8_t>(i * 37 % 256); }),
           f, 3);
+    }
+  });
+}
+
+// --- Gaussian smoothing ----------------------------------------------------------------------
+
+void expect_smoothing_equal(const SmoothingConfig& config, const VectorField& in,
+                            const GridMask& valid) {
+  FlowSmoother scalar;
+  FlowSmoother simd;
+  ASSERT_EQ(scalar.configure(config), Status::kOk);
+  ASSERT_EQ(simd.configure(config), Status::kOk);
+  VectorField out_scalar;
+  VectorField out_simd;
+  GridMask valid_scalar;
+  GridMask valid_simd;
+  scalar.apply_scalar(in, valid, out_scalar, valid_scalar);
+  simd.apply(in, valid, out_simd, valid_simd);
+  int mismatches = 0;
+  for (std::size_t p = 0; p < kGridCount; ++p) {
+    if ((out_scalar.x.v[p] != out_simd.x.v[p] || out_scalar.y.v[p] != out_simd.y.v[p] ||
+         valid_scalar.v[p] != valid_simd.v[p]) &&
+        ++mismatches <= 5) {
+      ADD_FAILURE() << "point " << p << ": scalar (" << out_scalar.x.v[p] << ", "
+                    << out_scalar.y.v[p] << ", " << int{valid_scalar.v[p]} << "), SIMD ("
+                    << out_simd.x.v[p] << ", " << out_simd.y.v[p] << ", " << int{valid_simd.v[p]}
+                    << ")";
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  // In place (out aliases in, out_valid aliases valid), as the pipeline may call it.
+  VectorField inout = in;
+  GridMask mask = valid;
+  simd.apply(inout, mask, inout, mask);
+  EXPECT_EQ(inout.x.v, out_scalar.x.v);
+  EXPECT_EQ(inout.y.v, out_scalar.y.v);
+  EXPECT_EQ(mask.v, valid_scalar.v);
+}
+
+// Every radius from 1 to kMaxRadius, both support thresholds' extremes.
+const SmoothingConfig kSmoothingConfigs[] = {{0.3, 0.25}, {0.7, 0.5},  {1.0, 0.25},
+                                             {1.5, 1.0},  {2.0, 0.01}, {3.0, 0.25}};
+
+TEST(SimdSmoothing, RandomFieldsAndMasksEqualScalar) {
+  for_each_target([] {
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<std::int32_t> any(INT32_MIN, INT32_MAX);
+    std::uniform_int_distribution<std::int32_t> flow(-(1 << 22), 1 << 22);  // +-64 px in Q16
+    for (const SmoothingConfig& c : kSmoothingConfigs) {
+      SCOPED_TRACE("sigma " + std::to_string(c.sigma_cells));
+      for (int hole_pct : {0, 10, 60}) {
+        VectorField in;
+        GridMask valid;
+        std::uniform_int_distribution<int> pct(0, 99);
+        for (std::size_t p = 0; p < kGridCount; ++p) {
+          const bool wide = hole_pct == 10;  // one case over the whole int32 range
+          in.x.v[p] = wide ? any(rng) : flow(rng);
+          in.y.v[p] = wide ? any(rng) : flow(rng);
+          valid.v[p] = pct(rng) >= hole_pct ? 1 : 0;
+        }
+        expect_smoothing_equal(c, in, valid);
+      }
+    }
+  });
+}
+
+TEST(SimdSmoothing, SaturatedFieldsAndEdgeMasksEqualScalar) {
+  for_each_target([] {
+    for (const SmoothingConfig& c : kSmoothingConfigs) {
+      SCOPED_TRACE("sigma " + std::to_string(c.sigma_cells));
+      VectorField in;
+      GridMask valid;
+      // Extremes: the row sums reach +-2^46, the column numerators +-2^61.
+      in.x.fill(INT32_MAX);
+      in.y.fill(INT32_MIN);
+      valid.fill(1);
+      expect_smoothing_equal(c, in, valid);
+      // Alternating extremes (every low 16-bit pattern of the row sums), a checkerboard mask.
+      for (std::size_t p = 0; p < kGridCount; ++p) {
+        in.x.v[p] = (p % 3 == 0) ? INT32_MIN : INT32_MAX - static_cast<std::int32_t>(p);
+        in.y.v[p] = (p % 2 == 0) ? -static_cast<std::int32_t>(p * 4099) : INT32_MIN + 1;
+        valid.v[p] = static_cast<std::uint8_t>(((p / kGridWidth) + p) % 2);
+      }
+      expect_smoothing_equal(c, in, valid);
+      valid.fill(0);  // nothing valid: every output 0 and invalid
+      expect_smoothing_equal(c, in, valid);
+      valid.fill(0);  // one valid point in a corner and one in the middle
+      valid.v[0] = 1;
+      valid.v[kGridCount / 2 + 7] = 1;
+      expect_smoothing_equal(c, in, valid);
     }
   });
 }

@@ -65,8 +65,13 @@ class FlowSmoother {
 
   // Smooths `in` over the valid points. `out` may alias `in` and `out_valid` may alias `valid`
   // (the rows are buffered internally). Cost: O(kGridCount * (2R+1)), no allocation.
+  // Runs on the best SIMD target (simd.hpp).
   void apply(const VectorField& in, const GridMask& valid, VectorField& out,
              GridMask& out_valid) noexcept;
+
+  // The scalar path of apply: the same result, bit for bit (tests, benchmarks).
+  void apply_scalar(const VectorField& in, const GridMask& valid, VectorField& out,
+                    GridMask& out_valid) noexcept;
 
   const SmoothingConfig& config() const noexcept { return config_; }
   int radius() const noexcept { return radius_; }
@@ -88,6 +93,20 @@ class FlowSmoother {
   std::array<std::int64_t, kGridCount> row_x_{};
   std::array<std::int64_t, kGridCount> row_y_{};
   std::array<std::int32_t, kGridCount> row_w_{};
+
+  // The SIMD path (smoothing_simd.cpp): the masked input with kMaxRadius zero columns either side,
+  // the row sums split into 16-bit halves with kMaxRadius zero rows above and below (the zero
+  // margins are never written); its numerators and weights go to row_x_, row_y_, row_w_.
+  static constexpr int kPadWidth = kGridWidth + 2 * kMaxRadius;
+  static constexpr int kPadHeight = kGridHeight + 2 * kMaxRadius;
+  std::array<std::int32_t, kGridHeight * kPadWidth> pad_x_{};
+  std::array<std::int32_t, kGridHeight * kPadWidth> pad_y_{};
+  std::array<std::int32_t, kGridHeight * kPadWidth> pad_w_{};
+  std::array<std::int32_t, kPadHeight * kGridWidth> hi_x_{};
+  std::array<std::int32_t, kPadHeight * kGridWidth> lo_x_{};
+  std::array<std::int32_t, kPadHeight * kGridWidth> hi_y_{};
+  std::array<std::int32_t, kPadHeight * kGridWidth> lo_y_{};
+  std::array<std::int32_t, kPadHeight * kGridWidth> sum_w_{};
 };
 
 }  // namespace tacse3::dsp
