@@ -33,12 +33,15 @@ test::Photometric photometric(std::uint64_t seed, double gain) {
   return ph;
 }
 
-void luma(benchmark::State& state, PixelFormat format) {
+// scalar: frame_to_work_image_scalar, the reference for the SIMD path's speed-up
+// (docs/performance.md).
+void luma(benchmark::State& state, PixelFormat format, bool scalar = false) {
   const auto bytes = test::render_frame(texture(), test::Warp::identity(), format);
   const auto view = test::frame_view(bytes, format);
   WorkImage out;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(tacse3::dsp::frame_to_work_image(view, out));
+    benchmark::DoNotOptimize(scalar ? tacse3::dsp::frame_to_work_image_scalar(view, out)
+                                    : tacse3::dsp::frame_to_work_image(view, out));
     benchmark::ClobberMemory();
   }
 }
@@ -51,9 +54,21 @@ void BM_LumaYuyv(benchmark::State& state) {
 void BM_LumaGrey(benchmark::State& state) {
   luma(state, PixelFormat::kGrey);
 }
+void BM_LumaRgb888Scalar(benchmark::State& state) {
+  luma(state, PixelFormat::kRgb888, true);
+}
+void BM_LumaYuyvScalar(benchmark::State& state) {
+  luma(state, PixelFormat::kYuyv, true);
+}
+void BM_LumaGreyScalar(benchmark::State& state) {
+  luma(state, PixelFormat::kGrey, true);
+}
 BENCHMARK(BM_LumaRgb888);
 BENCHMARK(BM_LumaYuyv);
 BENCHMARK(BM_LumaGrey);
+BENCHMARK(BM_LumaRgb888Scalar);
+BENCHMARK(BM_LumaYuyvScalar);
+BENCHMARK(BM_LumaGreyScalar);
 
 void BM_Pyramid3(benchmark::State& state) {
   const WorkImage img = test::render_work_image(texture(), test::Warp::identity());

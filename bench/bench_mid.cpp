@@ -82,19 +82,31 @@ struct MidStage {
   }
 };
 
-void BM_Smoothing(benchmark::State& state) {
+// scalar: FlowSmoother::apply_scalar, the reference for the SIMD path's speed-up.
+void smoothing(benchmark::State& state, bool scalar) {
   const Sequence& seq = sequence();
   auto stage = std::make_unique<MidStage>();
   const GridMask& valid = state.range(0) != 0 ? seq.valid_with_holes : seq.valid;
   int t = 0;
   for (auto _ : state) {
-    stage->smoother.apply(seq.flow[static_cast<std::size_t>(t)], valid, stage->smooth,
-                          stage->smooth_valid);
+    const VectorField& in = seq.flow[static_cast<std::size_t>(t)];
+    if (scalar) {
+      stage->smoother.apply_scalar(in, valid, stage->smooth, stage->smooth_valid);
+    } else {
+      stage->smoother.apply(in, valid, stage->smooth, stage->smooth_valid);
+    }
     benchmark::DoNotOptimize(stage->smooth);
     t = (t + 1) % kFrames;
   }
 }
+void BM_Smoothing(benchmark::State& state) {
+  smoothing(state, false);
+}
+void BM_SmoothingScalar(benchmark::State& state) {
+  smoothing(state, true);
+}
 BENCHMARK(BM_Smoothing)->ArgName("holes")->Arg(0)->Arg(1);
+BENCHMARK(BM_SmoothingScalar)->ArgName("holes")->Arg(0)->Arg(1);
 
 void BM_Density(benchmark::State& state) {
   const Sequence& seq = sequence();

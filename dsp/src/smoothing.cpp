@@ -23,8 +23,9 @@ std::int64_t div_round_half_up(std::int64_t a, std::int64_t b) noexcept {
 }
 
 // out(p) = numerator / weight, or invalid below the support threshold: the last step of both paths.
-void normalise(std::int64_t nx, std::int64_t ny, std::int64_t w, std::int64_t min_weight,
-               VectorField& out, GridMask& out_valid, std::size_t p) noexcept {
+[[gnu::always_inline]] inline void normalise(std::int64_t nx, std::int64_t ny, std::int64_t w,
+                                             std::int64_t min_weight, VectorField& out,
+                                             GridMask& out_valid, std::size_t p) noexcept {
   if (w == kFullWeight) {
     // Whole support valid and inside the grid: the division is a rounding shift.
     out.x.v[p] = sat32(rshift_round(nx, 2 * FlowSmoother::kTapFrac));
