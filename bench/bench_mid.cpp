@@ -108,18 +108,31 @@ void BM_SmoothingScalar(benchmark::State& state) {
 BENCHMARK(BM_Smoothing)->ArgName("holes")->Arg(0)->Arg(1);
 BENCHMARK(BM_SmoothingScalar)->ArgName("holes")->Arg(0)->Arg(1);
 
-void BM_Density(benchmark::State& state) {
+// scalar: GaussianDensity::compute_scalar.
+void density(benchmark::State& state, bool scalar) {
   const Sequence& seq = sequence();
   auto stage = std::make_unique<MidStage>();
   const GridMask& valid = state.range(0) != 0 ? seq.valid_with_holes : seq.valid;
   int t = 0;
   for (auto _ : state) {
-    stage->density.compute(seq.flow[static_cast<std::size_t>(t)], valid, stage->g);
+    const VectorField& u = seq.flow[static_cast<std::size_t>(t)];
+    if (scalar) {
+      stage->density.compute_scalar(u, valid, stage->g);
+    } else {
+      stage->density.compute(u, valid, stage->g);
+    }
     benchmark::DoNotOptimize(stage->g);
     t = (t + 1) % kFrames;
   }
 }
+void BM_Density(benchmark::State& state) {
+  density(state, false);
+}
+void BM_DensityScalar(benchmark::State& state) {
+  density(state, true);
+}
 BENCHMARK(BM_Density)->ArgName("holes")->Arg(0)->Arg(1);
+BENCHMARK(BM_DensityScalar)->ArgName("holes")->Arg(0)->Arg(1);
 
 // Arg: V-cycles per call (default config = 1).
 void BM_Nhhd(benchmark::State& state) {

@@ -5,10 +5,7 @@
 #include <cmath>
 #include <cstring>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
+#include "density_kernels.hpp"
 #include "tacse3/dsp/fixed.hpp"
 
 namespace tacse3::dsp {
@@ -32,47 +29,6 @@ inline void store4(std::int32_t* p, V4 v) noexcept {
 inline V4 splat4(std::int32_t a) noexcept {
   return V4{a, a, a, a};
 }
-
-// r^2 = clamp(dx)^2 + clamp(dy)^2 per lane, clamp to [-c, c] with c <= 24576 (exact, < 2^31), and
-// a * b per lane for a in int16 range, b in [0, 2^15): single pmaddwd instructions on SSE2 (the
-// 16-bit operands sit in the low halves; packssdw + pminsw/pmaxsw give exactly the symmetric
-// clamp). Elsewhere (NEON, scalar) the generic vector code computes the same values.
-#if defined(__SSE2__)
-inline __m128i as_m128(V4 v) noexcept {
-  __m128i r;
-  std::memcpy(&r, &v, sizeof r);
-  return r;
-}
-inline V4 as_v4(__m128i v) noexcept {
-  V4 r;
-  std::memcpy(&r, &v, sizeof r);
-  return r;
-}
-inline V4 clamped_r2(V4 dx, V4 dy, std::int32_t c) noexcept {
-  const __m128i packed = _mm_packs_epi32(as_m128(dx), as_m128(dy));  // dx0..3 dy0..3, saturated
-  __m128i pairs = _mm_unpacklo_epi16(packed, _mm_srli_si128(packed, 8));  // dx0 dy0 dx1 dy1 ...
-  const __m128i lim = _mm_set1_epi16(static_cast<std::int16_t>(c));
-  pairs = _mm_max_epi16(_mm_min_epi16(pairs, lim), _mm_sub_epi16(_mm_setzero_si128(), lim));
-  return as_v4(_mm_madd_epi16(pairs, pairs));
-}
-inline V4 mul_small(V4 a, V4 b) noexcept {
-  // a, b in [0, 2^15): the upper 16-bit halves are 0, so the madd of the halves is a * b.
-  return as_v4(_mm_madd_epi16(as_m128(a), as_m128(b)));
-}
-#else
-inline V4 clamped_r2(V4 dx, V4 dy, std::int32_t c) noexcept {
-  const V4 hi = splat4(c);
-  const V4 lo = -hi;
-  dx = dx > hi ? hi : dx;
-  dx = dx < lo ? lo : dx;
-  dy = dy > hi ? hi : dy;
-  dy = dy < lo ? lo : dy;
-  return dx * dx + dy * dy;
-}
-inline V4 mul_small(V4 a, V4 b) noexcept {
-  return a * b;
-}
-#endif
 
 }  // namespace
 
@@ -189,56 +145,24 @@ void GaussianDensity::update_undeformed(const GridMask& valid) noexcept {
   undeformed_ready_ = true;
 }
 
-// D(p) += K(p, q) and D(q) += K(p, q) for every unordered pair (p, q = p + offset), four pairs at
-// a time: distances, LUT index and interpolation in SIMD, the LUT reads scalar. A row's last group
-// is aligned to the row end and the lanes already done are masked out. The p and q groups are
-// read-modify-written one after the other, so overlapping groups (offsets (1..3, 0)) accumulate
-// correctly. kMasked: pairs with an invalid end contribute 0.
+// The scalar path of the pair loop: D(p) += K(p, q) and D(q) += K(p, q) for every unordered pair
+// (p, q = p + offset), K from kernel_of. kMasked: pairs with an invalid end contribute 0.
 template <bool kMasked>
-void GaussianDensity::accumulate_pairs() noexcept {
-  const int shift = lut_shift_;
-  const int frac_shift = shift > 15 ? shift - 15 : 0;
-  const int frac_bits = shift - frac_shift;
-  const std::int32_t frac_mask = (std::int32_t{1} << shift) - 1;
-  const V4 rnd = splat4(frac_bits > 0 ? (std::int32_t{1} << (frac_bits - 1)) : 0);
-  const std::int32_t c = component_limit_;
-  const std::int32_t* lut = lut_.data();
-  std::int32_t* dens = density_.v.data();
-  const std::int32_t* ux = ux_.v.data();
-  const std::int32_t* uy = uy_.v.data();
-  const std::int32_t* lm = lane_mask_.v.data();
-
-  const auto group = [&](int p, int q, V4 vbx, V4 vby) -> V4 {
-    const V4 dx = vbx + load4(ux + q) - load4(ux + p);
-    const V4 dy = vby + load4(uy + q) - load4(uy + p);
-    const V4 r2 = clamped_r2(dx, dy, c);
-    const V4 idx = r2 >> shift;  // <= 2N, inside the table
-    const V4 frac = (r2 & frac_mask) >> frac_shift;
-    const V4 e = {lut[idx[0]], lut[idx[1]], lut[idx[2]], lut[idx[3]]};
-    V4 k = (e & 0xFFFF) + ((rnd - mul_small(e >> 16, frac)) >> frac_bits);
-    if constexpr (kMasked) k &= load4(lm + p) & load4(lm + q);
-    return k;
-  };
-  const auto add = [&](int p, int q, V4 k) {
-    store4(dens + p, load4(dens + p) + k);
-    store4(dens + q, load4(dens + q) + k);
-  };
-
+void GaussianDensity::accumulate_pairs_scalar() noexcept {
   for (int n = 0; n < num_offsets_; ++n) {
     const Offset& o = offsets_[static_cast<std::size_t>(n)];
     const int x0 = o.ox < 0 ? -o.ox : 0;
-    const int x1 = o.ox > 0 ? kGridWidth - o.ox : kGridWidth;  // x1 - x0 >= 34
-    const int full = (x1 - x0) & ~3;
-    const V4 tail_mask = V4{0, 1, 2, 3} >= splat4(4 - ((x1 - x0) & 3));
-    const V4 vbx = splat4(o.ox * kCellQ10);
-    const V4 vby = splat4(o.oy * kCellQ10);
+    const int x1 = o.ox > 0 ? kGridWidth - o.ox : kGridWidth;
     const int step = o.oy * kGridWidth + o.ox;
     for (int y = 0; y + o.oy < kGridHeight; ++y) {
-      const int p0 = y * kGridWidth + x0;
-      for (int p = p0; p < p0 + full; p += 4) add(p, p + step, group(p, p + step, vbx, vby));
-      if (full != x1 - x0) {
-        const int p = p0 + (x1 - x0) - 4;
-        add(p, p + step, group(p, p + step, vbx, vby) & tail_mask);
+      for (int x = x0; x < x1; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y * kGridWidth + x);
+        const std::size_t q = p + static_cast<std::size_t>(step);
+        if (kMasked && (lane_mask_.v[p] & lane_mask_.v[q]) == 0) continue;
+        const std::int32_t k =
+            kernel_of(o.ox * kCellQ10 + ux_.v[q] - ux_.v[p], o.oy * kCellQ10 + uy_.v[q] - uy_.v[p]);
+        density_.v[p] += k;
+        density_.v[q] += k;
       }
     }
   }
@@ -246,6 +170,16 @@ void GaussianDensity::accumulate_pairs() noexcept {
 
 void GaussianDensity::compute(const VectorField& displacement, const GridMask& valid,
                               ScalarField& g) noexcept {
+  compute_with(true, displacement, valid, g);
+}
+
+void GaussianDensity::compute_scalar(const VectorField& displacement, const GridMask& valid,
+                                     ScalarField& g) noexcept {
+  compute_with(false, displacement, valid, g);
+}
+
+void GaussianDensity::compute_with(bool simd, const VectorField& displacement,
+                                   const GridMask& valid, ScalarField& g) noexcept {
   bool same_mask = undeformed_ready_;
   for (std::size_t p = 0; p < kGridCount && same_mask; ++p) {
     same_mask = (valid.v[p] != 0) == (cached_mask_.v[p] != 0);
@@ -276,10 +210,22 @@ void GaussianDensity::compute(const VectorField& displacement, const GridMask& v
 
   bool all_valid = true;
   for (std::size_t p = 0; p < kGridCount; ++p) all_valid = all_valid && valid.v[p] != 0;
-  if (all_valid) {
-    accumulate_pairs<false>();
+  if (simd) {
+    detail::DensityPairs s;
+    s.lut = lut_.data();
+    s.lut_shift = lut_shift_;
+    s.limit = component_limit_;
+    s.offsets = offsets_.data();
+    s.num_offsets = num_offsets_;
+    s.ux = ux_.v.data();
+    s.uy = uy_.v.data();
+    s.lane_mask = all_valid ? nullptr : lane_mask_.v.data();
+    s.density = density_.v.data();
+    detail::density_pairs_simd(s);
+  } else if (all_valid) {
+    accumulate_pairs_scalar<false>();
   } else {
-    accumulate_pairs<true>();
+    accumulate_pairs_scalar<true>();
   }
 
   for (std::size_t p = 0; p < kGridCount; ++p) {

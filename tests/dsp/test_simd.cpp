@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "tacse3/dsp/density.hpp"
 #include "tacse3/dsp/luma.hpp"
 #include "tacse3/dsp/simd.hpp"
 #include "tacse3/dsp/smoothing.hpp"
@@ -213,6 +214,85 @@ TEST(SimdSmoothing, SaturatedFieldsAndEdgeMasksEqualScalar) {
       valid.v[0] = 1;
       valid.v[kGridCount / 2 + 7] = 1;
       expect_smoothing_equal(c, in, valid);
+    }
+  });
+}
+
+// --- Gaussian density ------------------------------------------------------------------------
+
+// Both paths over the same calls (the undeformed density is cached per mask, so the second call
+// with an unchanged mask takes the cached path).
+void expect_density_equal(double sigma, const VectorField& u, const GridMask& valid) {
+  GaussianDensity scalar;
+  GaussianDensity simd;
+  ASSERT_EQ(scalar.configure(DensityConfig{sigma}), Status::kOk);
+  ASSERT_EQ(simd.configure(DensityConfig{sigma}), Status::kOk);
+  for (int call = 0; call < 2; ++call) {
+    ScalarField g_scalar;
+    ScalarField g_simd;
+    g_scalar.fill(12345);
+    g_simd.fill(-1);
+    scalar.compute_scalar(u, valid, g_scalar);
+    simd.compute(u, valid, g_simd);
+    EXPECT_EQ(scalar.density().v, simd.density().v) << "call " << call;
+    EXPECT_EQ(g_scalar.v, g_simd.v) << "call " << call;
+  }
+}
+
+const double kDensitySigmas[] = {0.5, 0.8, 1.0, 1.37, 2.0};
+
+TEST(SimdDensity, RandomDisplacementsAndMasksEqualScalar) {
+  for_each_target([] {
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<std::int32_t> any(INT32_MIN, INT32_MAX);
+    std::uniform_int_distribution<std::int32_t> flow(-(6 << 16), 6 << 16);  // +-6 px in Q16
+    std::uniform_int_distribution<int> pct(0, 99);
+    for (double sigma : kDensitySigmas) {
+      SCOPED_TRACE("sigma " + std::to_string(sigma));
+      for (int hole_pct : {0, 15, 70}) {
+        VectorField u;
+        GridMask valid;
+        for (std::size_t p = 0; p < kGridCount; ++p) {
+          const bool wide = hole_pct == 15;  // one case over the whole int32 range (clamped)
+          u.x.v[p] = wide ? any(rng) : flow(rng);
+          u.y.v[p] = wide ? any(rng) : flow(rng);
+          valid.v[p] = pct(rng) >= hole_pct ? 1 : 0;
+        }
+        expect_density_equal(sigma, u, valid);
+      }
+    }
+  });
+}
+
+TEST(SimdDensity, ClampedAndDegenerateInputsEqualScalar) {
+  for_each_target([] {
+    for (double sigma : kDensitySigmas) {
+      SCOPED_TRACE("sigma " + std::to_string(sigma));
+      VectorField u;
+      GridMask valid;
+      valid.fill(1);
+      expect_density_equal(sigma, u, valid);  // no motion: G == 0 everywhere
+      // Alternating extremes: every pair distance at the component clamp.
+      for (std::size_t p = 0; p < kGridCount; ++p) {
+        u.x.v[p] = p % 2 == 0 ? INT32_MAX : INT32_MIN;
+        u.y.v[p] = (p / kGridWidth) % 2 == 0 ? INT32_MIN : INT32_MAX;
+      }
+      expect_density_equal(sigma, u, valid);
+      // Compression by 0.3 cells per cell (distances through the LUT's whole range).
+      for (int y = 0; y < kGridHeight; ++y) {
+        for (int x = 0; x < kGridWidth; ++x) {
+          u.x(x, y) = -x * (kGridStride << 16) * 3 / 10;
+          u.y(x, y) = y * (kGridStride << 16) / 7;
+        }
+      }
+      expect_density_equal(sigma, u, valid);
+      // Only the first and last columns valid (row tails), then nothing valid.
+      for (int y = 0; y < kGridHeight; ++y) {
+        for (int x = 0; x < kGridWidth; ++x) valid(x, y) = x < 3 || x >= kGridWidth - 3 ? 1 : 0;
+      }
+      expect_density_equal(sigma, u, valid);
+      valid.fill(0);
+      expect_density_equal(sigma, u, valid);
     }
   });
 }

@@ -52,6 +52,15 @@ inline constexpr double kMaxDensitySigmaCells = 2.0;
 //    cached per mask (D0 >= 2^15 for a valid point, so R <= 2^31 and |product| < 2^53). Within
 //    1 LSB of the exactly rounded quotient; exactly 0 when D == D0. Range [-1, kMaxOffsets), no
 //    saturation needed.
+namespace detail {
+// A neighbour offset of the pair loop (GaussianDensity, density_simd.cpp).
+struct DensityOffset {
+  std::int32_t ox = 0;  // grid cells
+  std::int32_t oy = 0;
+  std::int32_t k0 = 0;  // Q15 kernel at the undeformed distance
+};
+}  // namespace detail
+
 class GaussianDensity {
  public:
   static constexpr int kMaxOffsets = 160;   // neighbour offsets within 3 sigma + 0.5 cells
@@ -69,7 +78,13 @@ class GaussianDensity {
   // g = G(p) in Q16 for every valid p, 0 for invalid p. Cost: O(kGridCount * offsets / 2)
   // (each unordered pair is evaluated once and added to both points). `g` must not alias the
   // inputs' storage (it is a different type anyway).
+  // Runs the pair loop on the best SIMD target (simd.hpp).
   void compute(const VectorField& displacement, const GridMask& valid, ScalarField& g) noexcept;
+
+  // The scalar path of compute: the same result, bit for bit, with kernel_of per pair (tests,
+  // benchmarks).
+  void compute_scalar(const VectorField& displacement, const GridMask& valid,
+                      ScalarField& g) noexcept;
 
   const DensityConfig& config() const noexcept { return config_; }
   // Kernel value in Q15 at distance r (working px), through the same integer LUT path as the
@@ -84,11 +99,7 @@ class GaussianDensity {
   const GridArray<std::int32_t>& density_undeformed() const noexcept { return density0_; }
 
  private:
-  struct Offset {
-    std::int32_t ox = 0;  // grid cells
-    std::int32_t oy = 0;
-    std::int32_t k0 = 0;  // Q15 kernel at the undeformed distance
-  };
+  using Offset = detail::DensityOffset;
   DensityConfig config_{};
   int lut_shift_ = 0;                 // LUT step is 2^lut_shift_ in Q20 px^2
   std::int32_t component_limit_ = 0;  // c = ceil(r_c) in Q10
@@ -96,8 +107,10 @@ class GaussianDensity {
   std::array<std::int32_t, kMaxLut> lut_{};
   std::array<Offset, kMaxOffsets / 2> offsets_{};
   void update_undeformed(const GridMask& valid) noexcept;
+  void compute_with(bool simd, const VectorField& displacement, const GridMask& valid,
+                    ScalarField& g) noexcept;
   template <bool kMasked>
-  void accumulate_pairs() noexcept;
+  void accumulate_pairs_scalar() noexcept;
 
   GridArray<std::int32_t> ux_{};  // Q10 displacements of the current call
   GridArray<std::int32_t> uy_{};
