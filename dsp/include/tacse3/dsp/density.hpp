@@ -36,6 +36,15 @@ struct DensityConfig {
 inline constexpr double kMinDensitySigmaCells = 0.5;
 inline constexpr double kMaxDensitySigmaCells = 2.0;
 
+namespace detail {
+// A neighbour offset of the pair loop (GaussianDensity, density_simd.cpp).
+struct DensityOffset {
+  std::int32_t ox = 0;  // grid cells
+  std::int32_t oy = 0;
+  std::int32_t k0 = 0;  // Q15 kernel at the undeformed distance
+};
+}  // namespace detail
+
 // Scaling and overflow:
 //  - input u: Q16 working px (any int32). Converted once per call to Q10 (round half-up, clamped
 //    to +-2^20 = +-1024 px, beyond the 160 px image so the clamp never changes a real distance).
@@ -52,15 +61,6 @@ inline constexpr double kMaxDensitySigmaCells = 2.0;
 //    cached per mask (D0 >= 2^15 for a valid point, so R <= 2^31 and |product| < 2^53). Within
 //    1 LSB of the exactly rounded quotient; exactly 0 when D == D0. Range [-1, kMaxOffsets), no
 //    saturation needed.
-namespace detail {
-// A neighbour offset of the pair loop (GaussianDensity, density_simd.cpp).
-struct DensityOffset {
-  std::int32_t ox = 0;  // grid cells
-  std::int32_t oy = 0;
-  std::int32_t k0 = 0;  // Q15 kernel at the undeformed distance
-};
-}  // namespace detail
-
 class GaussianDensity {
  public:
   static constexpr int kMaxOffsets = 160;   // neighbour offsets within 3 sigma + 0.5 cells
@@ -77,8 +77,8 @@ class GaussianDensity {
 
   // g = G(p) in Q16 for every valid p, 0 for invalid p. Cost: O(kGridCount * offsets / 2)
   // (each unordered pair is evaluated once and added to both points). `g` must not alias the
-  // inputs' storage (it is a different type anyway).
-  // Runs the pair loop on the best SIMD target (simd.hpp).
+  // inputs' storage (it is a different type anyway). The pair loop runs on the best SIMD target
+  // (simd.hpp).
   void compute(const VectorField& displacement, const GridMask& valid, ScalarField& g) noexcept;
 
   // The scalar path of compute: the same result, bit for bit, with kernel_of per pair (tests,
