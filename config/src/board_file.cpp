@@ -184,6 +184,31 @@ class Reader {
     fail(n, "key \"" + join(path, key) + "\" must be one of " + list + ", got \"" + s + "\"");
   }
 
+  // [left, right]: an array of two integers, each in [lo, hi].
+  void integer_pair(const toml::table& t, const char* key, const std::string& path, long long lo,
+                    long long hi, std::array<int, 2>* out) {
+    const toml::node* n = t.get(key);
+    if (n == nullptr || !ok()) return;
+    const std::string name = "key \"" + join(path, key) + "\" ";
+    const auto* a = n->as_array();
+    if (a == nullptr || a->size() != 2) {
+      fail(n, name + "must be [left, right], two integers, got " +
+                  (a ? std::to_string(a->size()) + " elements" : type_name(*n)));
+      return;
+    }
+    std::array<int, 2> v{};
+    for (std::size_t i = 0; i < 2; ++i) {
+      const auto* e = a->get(i) ? a->get(i)->as_integer() : nullptr;
+      if (e == nullptr || e->get() < lo || e->get() > hi) {
+        fail(n, name + "element " + std::to_string(i) + " must be an integer in [" +
+                    std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        return;
+      }
+      v[i] = static_cast<int>(e->get());
+    }
+    *out = v;
+  }
+
   // A 3x3 rotation matrix: 3 arrays of 3 numbers, orthonormal with det +1.
   void rotation(const toml::table& t, const char* key, const std::string& path,
                 std::array<std::array<double, 3>, 3>* out) {
@@ -285,7 +310,7 @@ void read_sensor(Reader& rd, const toml::table& t, const std::string& path, Sens
   s->enabled = true;
   if (!rd.only_keys(t, path,
                     {"backend", "device", "width", "height", "fps", "buffer_count", "allow_mjpeg",
-                     "rotation"})) {
+                     "rotation", "phase_us"})) {
     return;
   }
   if (t.get("backend") == nullptr) {
@@ -307,7 +332,12 @@ void read_sensor(Reader& rd, const toml::table& t, const std::string& path, Sens
   rd.integer(t, "buffer_count", path, 2, 16, &s->buffer_count);
   rd.boolean(t, "allow_mjpeg", path, &s->allow_mjpeg);
   rd.rotation(t, "rotation", path, &s->rotation);
+  rd.integer(t, "phase_us", path, 0, 1'000'000, &s->phase_us);
   if (!rd.ok()) return;
+  if (t.get("phase_us") != nullptr && s->backend != CameraBackend::kReplay) {
+    rd.fail(t.get("phase_us"), "key \"" + path + ".phase_us\" is for backend \"replay\" only");
+    return;
+  }
   const bool needs_device =
       s->backend == CameraBackend::kV4l2 || s->backend == CameraBackend::kReplay;
   if (needs_device && s->device.empty()) {
@@ -503,9 +533,10 @@ bool parse_impl(std::string_view text, const std::string& origin, BoardConfig* o
   }
 
   if (const toml::table* t = rd.table(root, "realtime", "")) {
-    rd.only_keys(*t, "realtime", {"dsp_cpu", "dsp_priority"});
+    rd.only_keys(*t, "realtime", {"dsp_cpu", "dsp_priority", "pad_cpus"});
     rd.integer(*t, "dsp_cpu", "realtime", -1, 1023, &b.realtime.dsp_cpu);
     rd.integer(*t, "dsp_priority", "realtime", 0, 99, &b.realtime.dsp_priority);
+    rd.integer_pair(*t, "pad_cpus", "realtime", -1, 1023, &b.realtime.pad_cpus);
   }
 
   if (const toml::table* t = rd.table(root, "record", "")) {
@@ -674,7 +705,8 @@ std::string describe(const BoardConfig& b) {
       << (l.active_low ? " (active low)" : "");
   }
   s << "\n  realtime: dsp cpu " << b.realtime.dsp_cpu << ", SCHED_FIFO priority "
-    << b.realtime.dsp_priority << "\n";
+    << b.realtime.dsp_priority << "; pad cpus " << b.realtime.pad_cpus[0] << ", "
+    << b.realtime.pad_cpus[1] << "\n";
   s << "  record: " << (b.record.dir.empty() ? "none (START_RECORDING refused)" : b.record.dir)
     << "\n";
   s << "  viewer: "

@@ -67,6 +67,11 @@ TEST(Board, ShippedBoardsLoad) {
   EXPECT_EQ(pi5.can.data_bitrate, 2000000);
   EXPECT_EQ(pi5.sensors[0].backend, CameraBackend::kLibcamera);
   EXPECT_EQ(pi5.gpio.lines.line(GpioLine::kStatusLed).name, "GPIO17");
+  // Four cores: the pads' capture threads on 1 and 2, the DSP thread on 3.
+  for (const BoardConfig* b : {&uvc, &pi5}) {
+    EXPECT_EQ(b->realtime.pad_cpus, (std::array<int, 2>{1, 2}));
+    EXPECT_EQ(b->realtime.dsp_cpu, 3);
+  }
 }
 
 TEST(Board, MissingTablesTakeTheDocumentedDefaults) {
@@ -390,6 +395,51 @@ TEST(Board, ViewerListenIsOffByDefaultAndChecked) {
       << port;
   const std::string addr = error_of(std::string(kMinimal) + "[viewer]\nlisten = \"board:80\"\n");
   EXPECT_NE(addr.find("the address must be an IPv4 address"), std::string::npos) << addr;
+}
+
+// [realtime] pad_cpus: [left, right], -1 (the default) leaves a pad's thread unpinned.
+TEST(Board, PadCpusArePairsOfCpuNumbers) {
+  BoardConfig b;
+  std::string e;
+  ASSERT_TRUE(parse_board(kMinimal, "test.toml", &b, &e)) << e;
+  EXPECT_EQ(b.realtime.pad_cpus, (std::array<int, 2>{-1, -1}));
+  ASSERT_TRUE(
+      parse_board(std::string(kMinimal) + "[realtime]\npad_cpus = [0, -1]\n", "test.toml", &b, &e))
+      << e;
+  EXPECT_EQ(b.realtime.pad_cpus, (std::array<int, 2>{0, -1}));
+  EXPECT_NE(describe(b).find("pad cpus 0, -1"), std::string::npos) << describe(b);
+  const std::string one = error_of(std::string(kMinimal) + "[realtime]\npad_cpus = [2]\n");
+  EXPECT_NE(one.find("test.toml:5: key \"realtime.pad_cpus\" must be [left, right], two "
+                     "integers, got 1 elements"),
+            std::string::npos)
+      << one;
+  const std::string range = error_of(std::string(kMinimal) + "[realtime]\npad_cpus = [1, -2]\n");
+  EXPECT_NE(range.find("key \"realtime.pad_cpus\" element 1 must be an integer in [-1, 1023]"),
+            std::string::npos)
+      << range;
+  const std::string type = error_of(std::string(kMinimal) + "[realtime]\npad_cpus = 2\n");
+  EXPECT_NE(type.find("realtime.pad_cpus\" must be [left, right]"), std::string::npos) << type;
+  const std::string real = error_of(std::string(kMinimal) + "[realtime]\npad_cpus = [1.0, 2]\n");
+  EXPECT_NE(real.find("element 0 must be an integer"), std::string::npos) << real;
+}
+
+// phase_us: a replay pad's delay, for the replay backend only.
+TEST(Board, PhaseIsForReplayPadsOnly) {
+  BoardConfig b;
+  std::string e;
+  ASSERT_TRUE(
+      parse_board("version = 1\n[sensors.right]\nbackend = \"replay\"\ndevice = \"r\"\n"
+                  "phase_us = 1500\n",
+                  "test.toml", &b, &e))
+      << e;
+  EXPECT_EQ(b.sensors[1].phase_us, 1500);
+  const std::string sim = error_of(std::string(kMinimal) + "phase_us = 10\n");
+  EXPECT_NE(sim.find("key \"sensors.left.phase_us\" is for backend \"replay\" only"),
+            std::string::npos)
+      << sim;
+  const std::string neg = error_of(
+      "version = 1\n[sensors.left]\nbackend = \"replay\"\ndevice = \"r\"\nphase_us = -1\n");
+  EXPECT_NE(neg.find("sensors.left.phase_us\" must be in [0, 1000000]"), std::string::npos) << neg;
 }
 
 TEST(Board, ViewerControlsAreOffByDefault) {

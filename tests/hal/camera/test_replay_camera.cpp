@@ -174,6 +174,33 @@ TEST(ReplayCamera, PacedToTheRecordedTimes) {
   fs::remove_all(dir);
 }
 
+// phase_ns delays a pad's frames (stamps and, paced, delivery): two replay cameras started
+// together play free-running cameras this far apart.
+TEST(ReplayCamera, PhaseDelaysEveryFrame) {
+  const fs::path dir = make_recording("phase", 1);
+  auto left = make_replay_camera(config(dir, true));
+  auto c = config(dir, true, true);
+  c.phase_ns = 5'000'000;
+  auto right = make_replay_camera(c);
+  ASSERT_TRUE(left->open().ok());
+  ASSERT_TRUE(right->open().ok());
+  const std::int64_t t0 = monotonic_ns();
+  ASSERT_TRUE(left->start().ok());
+  ASSERT_TRUE(right->start().ok());
+  const std::int64_t started_apart = monotonic_ns() - t0;
+  for (int i = 0; i < 3; ++i) {
+    Frame l, r;
+    ASSERT_TRUE(left->next_frame(l, 1000).ok());
+    ASSERT_TRUE(right->next_frame(r, 1000).ok());
+    EXPECT_GE(monotonic_ns(), r.timestamp_ns) << "delivered before its (delayed) time";
+    EXPECT_GE(r.timestamp_ns - l.timestamp_ns, 5'000'000) << i;
+    EXPECT_LE(r.timestamp_ns - l.timestamp_ns, 5'000'000 + started_apart) << i;
+    left->release(l);
+    right->release(r);
+  }
+  fs::remove_all(dir);
+}
+
 TEST(ReplayCamera, LoopStartsOverWithLaterTimestamps) {
   const fs::path dir = make_recording("loop", 3);
   auto c = config(dir, false);

@@ -31,6 +31,9 @@ struct SensorBoardConfig {
   int fps = 120;
   int buffer_count = 4;
   bool allow_mjpeg = true;
+  // replay only: delay of this pad's frames after the start (the offset between two
+  // free-running cameras), microseconds.
+  int phase_us = 0;
   // Pad orientation in the gripper frame G (row-major R_GS).
   std::array<std::array<double, 3>, 3> rotation{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
 };
@@ -101,6 +104,8 @@ struct GpioBoardConfig {
 struct RealtimeConfig {
   int dsp_cpu = 3;        // -1 = do not pin
   int dsp_priority = 80;  // SCHED_FIFO priority, 0 = normal scheduling
+  // The CPU each pad's capture thread is pinned to ([left, right]; -1 = do not pin).
+  std::array<int, 2> pad_cpus{-1, -1};
 };
 
 // A quaternion in the board file is accepted as unit when its norm is within this of 1, as in

@@ -267,7 +267,7 @@ CameraStatus ReplayCamera::start() {
   pending_slot_ = -1;
   pending_bad_ = false;
   ended_reported_ = false;
-  start_ns_ = monotonic_ns() + nominal_period_ns_;
+  start_ns_ = monotonic_ns() + nominal_period_ns_ + std::max<std::int64_t>(cfg_.phase_ns, 0);
   state_.store(LinkState::kStreaming, std::memory_order_release);
   return CameraStatus::success();
 }

@@ -15,6 +15,9 @@ struct ReplayCameraConfig {
   bool realtime = true;  // pace to frames.csv's t_ns; false: as fast as consumed
   bool loop = false;     // start over after the last frame instead of ending
   int buffer_count = 4;  // 2..16 decoded-frame buffers, all allocated in open()
+  // Delay of every frame (its stamp and, paced, its delivery) after start(), >= 0: two replay
+  // cameras with different phases play two free-running cameras' offset between the pads.
+  std::int64_t phase_ns = 0;
 };
 
 // Statistics beyond CameraStats: how the PNG decoder's memory was served.
@@ -33,9 +36,9 @@ struct ReplayDecodeStats {
 // file buffer and libspng gets an arena allocator (spng_ctx_new2) that is reset per frame.
 //
 // Timestamps: CLOCK_MONOTONIC, TimestampSource::kSimulated: frame i of the recording is stamped
-// start + (t_i - t_0), where start is the time of start() plus one nominal period; every loop
-// adds the recording's span plus one nominal period. Sequence numbers count delivered frames
-// from 0 (loops continue counting).
+// start + (t_i - t_0), where start is the time of start() plus one nominal period plus the
+// phase; every loop adds the recording's span plus one nominal period. Sequence numbers count
+// delivered frames from 0 (loops continue counting).
 //
 // Errors: a corrupt or vanished PNG gives kCorruptFrame naming the file (counted in
 // stats.corrupt; the next call continues with the next frame). The end of the recording (no loop)
