@@ -49,7 +49,9 @@ namespace {
 constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr int kCaptureTimeoutMs = 100;  // bounds how long a capture thread takes to see stop
 constexpr int kRxTimeoutMs = 100;
-constexpr std::int64_t kIdleSleepNs = 200'000;  // DSP loop with nothing to do (docs: latency)
+// The DSP loop's longest wait with nothing to do: a frame or a command rings it awake earlier
+// (Doorbell); the wait bounds how late a status or a stale pad is noticed.
+constexpr std::int64_t kIdleSleepNs = 200'000;
 constexpr std::size_t kDspStackPrefault = 256 * 1024;
 // Stack sizes (docs/performance.md, "Thread stacks"): mlockall(MCL_FUTURE) keeps every byte of
 // a thread's stack resident, so each thread gets what it was measured to touch, with a margin.
@@ -243,6 +245,7 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
         rc.realtime = board.sim.realtime;
         rc.loop = board.sim.repeat;
         rc.buffer_count = sc.buffer_count;
+        rc.phase_ns = static_cast<std::int64_t>(sc.phase_us) * 1000;
         d->cameras_[s] = hal::make_replay_camera(rc);
         break;
 #else
@@ -499,9 +502,12 @@ void Daemon::capture_loop(std::size_t s) {
   std::uint64_t overflow = 0;
   bool reported_error = false;
   bool reported_bad = false;
+  const std::string pinned = pin_current_thread(board_.realtime.pad_cpus[s]);
+  if (!pinned.empty()) say(1, "sensor %s: capture thread %s", side, pinned.c_str());
   while (!stop_.load(std::memory_order_acquire)) {
-    hal::Frame f;
-    const hal::CameraStatus st = cam.next_frame(f, kCaptureTimeoutMs);
+    ArrivedFrame f;
+    const hal::CameraStatus st = cam.next_frame(f.frame, kCaptureTimeoutMs);
+    f.arrival_ns = hal::monotonic_ns();
     if (st.ok()) {
       if (sh.disconnected.load(std::memory_order_relaxed))
         say(1, "sensor %s: streaming again", side);
@@ -515,10 +521,11 @@ void Daemon::capture_loop(std::size_t s) {
       }
       if (!queued) {
         // The DSP thread is behind by a whole ring: drop the newest, counted.
-        cam.release(f);
+        cam.release(f.frame);
         ++overflow;
       } else {
         sh.frames.fetch_add(1, std::memory_order_relaxed);
+        doorbell_.ring();
       }
       sh.camera_drops.store(cam.stats().drops + overflow, std::memory_order_relaxed);
       continue;
@@ -558,7 +565,9 @@ void Daemon::dsp_loop() {
   engine_->start(hal::monotonic_ns());
   dsp_ready_.store(true, std::memory_order_release);
   while (!stop_.load(std::memory_order_acquire)) {
-    if (!engine_->step(hal::monotonic_ns())) sleep_ns(kIdleSleepNs);
+    // Read before the step: a frame or command handed over during it ends the wait at once.
+    const std::uint32_t rung = doorbell_.value();
+    if (!engine_->step(hal::monotonic_ns())) doorbell_.wait(rung, kIdleSleepNs);
   }
 }
 
@@ -577,6 +586,7 @@ void Daemon::rx_loop() {
       const protocol::CommandResult res = receiver.receive(rx.frame);
       shared_.rejected_commands.store(receiver.stats().rejected(), std::memory_order_relaxed);
       if (res.addressed && !ring.push(res)) say(1, "command queue full: command dropped");
+      if (res.addressed) doorbell_.ring();
     } else if (r == hal::can::RxResult::kEnd) {
       sleep_ns(kRxTimeoutMs * 1'000'000LL);  // no command input (log backend writing only)
     } else if (r == hal::can::RxResult::kError) {
@@ -872,18 +882,28 @@ void Daemon::finish_summary() {
   summary_.last_cycle = engine_->last_cycle();
   summary_.latency_p50_us = engine_->latency_percentile_us(50);
   summary_.latency_p99_us = engine_->latency_percentile_us(99);
+  const CycleLatency& lat = engine_->latency();
+  summary_.later_arrival_p50_us = lat.later_arrival().percentile(50);
+  summary_.later_arrival_p99_us = lat.later_arrival().percentile(99);
+  summary_.earlier_arrival_p50_us = lat.earlier_arrival().percentile(50);
+  summary_.earlier_arrival_p99_us = lat.earlier_arrival().percentile(99);
   summary_.dsp_p50_us = engine_->dsp_time_percentile_us(50);
   const EngineStats& e = summary_.engine;
   if (!calibration_.fitted()) say(0, "UNCALIBRATED run: the estimates below are not to scale");
   say(1,
       "stopped after %.2f s of streaming: %llu samples (%llu pairs, %llu single), %llu cycles "
       "sent, "
-      "latency p50 %lld us p99 %lld us, dsp p50 %lld us",
+      "latency p50 %lld us p99 %lld us, dsp p50 %lld us; from the later frame's arrival p50 "
+      "%lld us p99 %lld us, from the earlier's p50 %lld us p99 %lld us",
       summary_.streaming_s, static_cast<unsigned long long>(e.samples),
       static_cast<unsigned long long>(e.pairs), static_cast<unsigned long long>(e.singles),
       static_cast<unsigned long long>(e.cycles_sent),
       static_cast<long long>(summary_.latency_p50_us),
-      static_cast<long long>(summary_.latency_p99_us), static_cast<long long>(summary_.dsp_p50_us));
+      static_cast<long long>(summary_.latency_p99_us), static_cast<long long>(summary_.dsp_p50_us),
+      static_cast<long long>(summary_.later_arrival_p50_us),
+      static_cast<long long>(summary_.later_arrival_p99_us),
+      static_cast<long long>(summary_.earlier_arrival_p50_us),
+      static_cast<long long>(summary_.earlier_arrival_p99_us));
   if (rig_ && e.cycles_sent > 0) {
     const protocol::Cycle& c = summary_.last_cycle;
     const std::int64_t t_ns = static_cast<std::int64_t>(c.timestamp_us) * 1000;

@@ -9,8 +9,6 @@
 #include <cmath>
 #include <limits>
 
-#include "tacse3/hal/camera/clock.hpp"
-
 namespace tacse3::firmware {
 
 namespace {
@@ -115,9 +113,9 @@ void Engine::refill_heads(std::int64_t now_ns) noexcept {
   for (std::size_t s = 0; s < 2; ++s) {
     Head& h = heads_[s];
     if (h.pending.present || rings_[s] == nullptr) continue;
-    if (rings_[s]->pop(h.frame)) {
+    if (rings_[s]->pop(h.arrived)) {
       h.pending.present = true;
-      h.pending.t_ns = h.frame.timestamp_ns;
+      h.pending.t_ns = h.arrived.frame.timestamp_ns;
       h.pending.arrival_ns = now_ns;
       observed_[s].seen = true;
       observed_[s].last_frame_ns = now_ns;
@@ -128,7 +126,7 @@ void Engine::refill_heads(std::int64_t now_ns) noexcept {
 void Engine::release_head(std::size_t s) noexcept {
   Head& h = heads_[s];
   if (!h.pending.present) return;
-  if (cameras_[s] != nullptr) cameras_[s]->release(h.frame);
+  if (cameras_[s] != nullptr) cameras_[s]->release(h.arrived.frame);
   h.pending.present = false;
 }
 
@@ -136,9 +134,9 @@ void Engine::release_all() noexcept {
   for (std::size_t s = 0; s < 2; ++s) {
     release_head(s);
     if (rings_[s] == nullptr) continue;
-    hal::Frame f;
+    ArrivedFrame f;
     while (rings_[s]->pop(f)) {
-      if (cameras_[s] != nullptr) cameras_[s]->release(f);
+      if (cameras_[s] != nullptr) cameras_[s]->release(f.frame);
     }
   }
 }
@@ -326,18 +324,16 @@ protocol::Ack Engine::answer(const protocol::CommandResult& r) noexcept {
 }
 
 void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcept {
-  const dsp::FrameView* l = use_left ? &heads_[0].frame.view : nullptr;
-  const dsp::FrameView* r = use_right ? &heads_[1].frame.view : nullptr;
+  const dsp::FrameView* l = use_left ? &heads_[0].arrived.frame.view : nullptr;
+  const dsp::FrameView* r = use_right ? &heads_[1].arrived.frame.view : nullptr;
+  // The sample time of a pair is the later timestamp (docs/firmware.md, Pairing).
   std::int64_t t_ns = INT64_MIN;
-  std::int64_t t_first_ns = INT64_MAX;
   for (std::size_t s = 0; s < 2; ++s) {
-    if (!(s == 0 ? use_left : use_right)) continue;
-    t_ns = std::max(t_ns, heads_[s].pending.t_ns);
-    t_first_ns = std::min(t_first_ns, heads_[s].pending.t_ns);
+    if (s == 0 ? use_left : use_right) t_ns = std::max(t_ns, heads_[s].pending.t_ns);
   }
-  const std::int64_t t0 = hal::monotonic_ns();
+  const std::int64_t t0 = config_.clock();
   pipeline_.process(l, r, t_ns, result_);
-  const std::int64_t t1 = hal::monotonic_ns();
+  const std::int64_t t1 = config_.clock();
   last_dsp_us_ = std::clamp<std::int64_t>((t1 - t0) / 1000, 0, UINT32_MAX);
   dsp_time_.add(static_cast<std::uint32_t>(last_dsp_us_));
 #if TACSE3_HAVE_RECORDER
@@ -346,8 +342,6 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   have_result_ = true;
   last_t_ns_ = t_ns;
   if (use_left && use_right) last_pair_t_ns_ = t_ns;
-  if (use_left) release_head(0);
-  if (use_right) release_head(1);
   ++stats_.samples;
   (use_left && use_right ? stats_.pairs : stats_.singles) += 1;
   shared_.cycles.store(stats_.samples, std::memory_order_relaxed);
@@ -365,7 +359,14 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
 
   const bool emit = stream_enabled_ && (sample_index_ % rate_divider_) == 0;
   ++sample_index_;
-  if (!emit) return;
+  if (emit) emit_cycle(use_left, use_right, t_ns);
+  if (use_left) release_head(0);
+  if (use_right) release_head(1);
+}
+
+// Encodes and sends the cycle of the sample just processed (heads still held: their arrival
+// times start the latencies).
+void Engine::emit_cycle(bool use_left, bool use_right, std::int64_t t_ns) noexcept {
   protocol::Cycle c;
   c.timestamp_us = static_cast<std::uint64_t>(std::max<std::int64_t>(t_ns, 0) / 1000);
   c.estimate_valid = result_.valid;
@@ -382,20 +383,22 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   bool all_sent = true;
   for (std::size_t i = 0; i < cycle_frames_.count; ++i)
     all_sent = send(cycle_frames_.frames[i]) && all_sent;
-  const std::int64_t t_sent = hal::monotonic_ns();
-  // Frame timestamp -> last frame of the cycle handed to the channel. Only meaningful when the
-  // camera stamps on CLOCK_MONOTONIC; anything outside (0, 10 s) is not a latency.
-  const std::int64_t latency_ns = t_sent - t_first_ns;
-  if (latency_ns > 0 && latency_ns < 10'000'000'000) {
-    latency_.add(static_cast<std::uint32_t>(latency_ns / 1000));
-    last_latency_us_ = latency_ns / 1000;
+  CycleLatency::Times lt;
+  lt.sent_ns = config_.clock();
+  lt.sample_ns = t_ns;
+  lt.later_arrival_ns = INT64_MIN;
+  lt.earlier_arrival_ns = INT64_MAX;
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (!(s == 0 ? use_left : use_right)) continue;
+    lt.later_arrival_ns = std::max(lt.later_arrival_ns, heads_[s].arrived.arrival_ns);
+    lt.earlier_arrival_ns = std::min(lt.earlier_arrival_ns, heads_[s].arrived.arrival_ns);
   }
+  latency_.add(lt);
   pose_reset_pending_ = false;
   cycle_counter_ = static_cast<std::uint8_t>((cycle_counter_ + 1) & 0x0F);
   last_cycle_ = cycle_frames_.sent;
   if (all_sent) ++stats_.cycles_sent;
   shared_.emitted.store(stats_.cycles_sent, std::memory_order_relaxed);
-  (void)now_ns;
 }
 
 protocol::StatusMsg Engine::status_message() const noexcept {
@@ -438,8 +441,8 @@ void Engine::send_status_group() noexcept {
     (s == 0 ? g.contact.confidence_left : g.contact.confidence_right) = conf;
   }
   g.timing.dsp_time_s = us_to_s(dsp_time_.percentile(50));
-  g.timing.latency_p50_s = us_to_s(latency_.percentile(50));
-  g.timing.latency_p99_s = us_to_s(latency_.percentile(99));
+  g.timing.latency_p50_s = us_to_s(latency_.sample().percentile(50));
+  g.timing.latency_p99_s = us_to_s(latency_.sample().percentile(99));
   for (std::size_t s = 0; s < 2; ++s) {
     const std::uint64_t d =
         shared_.sensors[s].camera_drops.load(std::memory_order_relaxed) + pairing_drops_[s];
@@ -599,7 +602,7 @@ void Engine::publish_view(std::int64_t now_ns) noexcept {
   v.p = {result_.pose.p.x(), result_.pose.p.y(), result_.pose.p.z()};
   v.confidence = have_result_ && result_.valid ? clamp01_or_nan(result_.confidence) : 0.0;
   v.dsp_us = have_result_ ? last_dsp_us_ : -1;
-  v.latency_us = last_latency_us_;
+  v.latency_us = latency_.last_sample_us();
   fill_view_pads(pipeline_, result_, state_, config_.configured, &v);
   v.counters.cycles_sent = stats_.cycles_sent;
   v.counters.can_send_failures = stats_.send_failures;

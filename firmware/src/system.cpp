@@ -33,6 +33,21 @@ __attribute__((noinline)) void prefault_stack(std::size_t bytes) noexcept {
 
 }  // namespace
 
+std::string pin_current_thread(int cpu) {
+  if (cpu < 0) return {};
+  const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+  if (cpu >= ncpu) {
+    return "CPU " + std::to_string(cpu) + " does not exist (" + std::to_string(ncpu) +
+           " online), not pinned";
+  }
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  const int e = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+  if (e == 0) return {};
+  return "pin to CPU " + std::to_string(cpu) + ": " + std::strerror(e);
+}
+
 RealtimeResult setup_realtime_thread(int priority, int cpu, std::size_t stack_bytes) noexcept {
   RealtimeResult r;
   std::string missing;
@@ -59,22 +74,9 @@ RealtimeResult setup_realtime_thread(int priority, int cpu, std::size_t stack_by
     }
   }
   if (cpu >= 0) {
-    const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-    if (cpu >= ncpu) {
-      missing += std::string(missing.empty() ? "" : "; ") + "CPU " + std::to_string(cpu) +
-                 " does not exist (" + std::to_string(ncpu) + " online), not pinned";
-    } else {
-      cpu_set_t set;
-      CPU_ZERO(&set);
-      CPU_SET(cpu, &set);
-      const int e = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
-      if (e == 0) {
-        r.pinned = true;
-      } else {
-        missing += std::string(missing.empty() ? "" : "; ") + "pin to CPU " + std::to_string(cpu) +
-                   ": " + std::strerror(e);
-      }
-    }
+    const std::string pin = pin_current_thread(cpu);
+    r.pinned = pin.empty();
+    if (!pin.empty()) missing += std::string(missing.empty() ? "" : "; ") + pin;
   }
   r.message = missing;
   return r;

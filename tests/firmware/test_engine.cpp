@@ -19,6 +19,12 @@ namespace {
 
 constexpr std::int64_t kPeriod = 8'333'333;
 
+// The engine's clock in LatenciesRunFromTheSampleTimeAndTheFramesArrivals.
+std::int64_t g_clock_ns = 0;
+std::int64_t fake_clock() noexcept {
+  return g_clock_ns;
+}
+
 // Records sent frames into storage reserved up front (no allocation while the loop runs).
 class RecordingChannel final : public hal::can::Channel {
  public:
@@ -78,6 +84,10 @@ class EngineTest : public ::testing::Test {
     ASSERT_EQ(pipeline_->configure(dual, {cal, cal}), dsp::Status::kOk);
     EngineConfig ec;
     ec.pairing = pairing_config(2000, 50);
+    make_engine(ec);
+  }
+
+  void make_engine(const EngineConfig& ec) {
     engine_ = std::make_unique<Engine>(ec, *pipeline_, channel_, std::array<hal::Camera*, 2>{},
                                        std::array<FrameRing*, 2>{&rings_[0], &rings_[1]},
                                        std::array<CommandRing*, 2>{&commands_[0], &commands_[1]},
@@ -99,14 +109,19 @@ class EngineTest : public ::testing::Test {
   // Queues frame i of the sensors asked for, without running the loop.
   void push(std::size_t i, bool left = true, bool right = true) {
     for (std::size_t s = 0; s < 2; ++s) {
-      if (!(s == 0 ? left : right)) continue;
-      hal::Frame f;
-      const auto& img = (*frames_)[2 * (i % frame_count()) + s];
-      f.view = {img.data(), img.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
-      f.timestamp_ns = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
-      f.sequence = static_cast<std::uint32_t>(i);
-      ASSERT_TRUE(rings_[s].push(f));
+      if (s == 0 ? left : right) push_pad(i, s, 1'000'000'000 + std::int64_t(i) * kPeriod, 0);
     }
+  }
+
+  // Queues pad s's frame i stamped t_ns, handed over by its capture thread at arrival_ns.
+  void push_pad(std::size_t i, std::size_t s, std::int64_t t_ns, std::int64_t arrival_ns) {
+    ArrivedFrame a;
+    const auto& img = (*frames_)[2 * (i % frame_count()) + s];
+    a.frame.view = {img.data(), img.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+    a.frame.timestamp_ns = t_ns;
+    a.frame.sequence = static_cast<std::uint32_t>(i);
+    a.arrival_ns = arrival_ns;
+    ASSERT_TRUE(rings_[s].push(a));
   }
 
   void command(const protocol::Command& c) {
@@ -493,6 +508,55 @@ TEST_F(EngineTest, LoopDoesNotAllocate) {
   // are 49.99998 ms), so 120 ticks publish 17 or 18 times.
   EXPECT_GE(view_->published(), 17u);
   EXPECT_LE(view_->published(), 18u);
+}
+
+// StatusTiming's latency runs from the cycle's SampleTime (the later frame's stamp, which the
+// Timestamp frame carries and tacse3-truth subtracts); the arrival latencies from the moments the
+// capture threads handed the later and the earlier frame over. Right pad 1.5 ms after the left
+// (within the 2 ms pair tolerance), each arriving 0.3 ms after its stamp, the cycle sent 0.7 ms
+// after the right frame's arrival (the injected clock).
+TEST_F(EngineTest, LatenciesRunFromTheSampleTimeAndTheFramesArrivals) {
+  EngineConfig ec;
+  ec.pairing = pairing_config(2000, 50);
+  ec.clock = &fake_clock;
+  make_engine(ec);
+  for (std::size_t i = 0; i < 30; ++i) {
+    const std::int64_t t_left = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
+    const std::int64_t t_right = t_left + 1'500'000;
+    push_pad(i, 0, t_left, t_left + 300'000);
+    push_pad(i, 1, t_right, t_right + 300'000);
+    g_clock_ns = t_right + 300'000 + 700'000;
+    now_ = g_clock_ns;
+    engine_->step(now_);
+  }
+  ASSERT_EQ(engine_->stats().pairs, 30u);
+  const CycleLatency& l = engine_->latency();
+  EXPECT_EQ(l.later_arrival().percentile(50), 700);
+  EXPECT_EQ(l.later_arrival().percentile(99), 700);
+  EXPECT_EQ(l.earlier_arrival().percentile(50), 1500 + 300 + 700 - 300);
+  EXPECT_EQ(l.sample().percentile(50), 300 + 700);
+  EXPECT_EQ(engine_->latency_percentile_us(99), 1000);
+  EXPECT_EQ(engine_->dsp_time_percentile_us(50), 0);  // the clock stood still
+  const auto b = decode();
+  ASSERT_EQ(b.timings.size(), 3u);  // 10 Hz over 30 periods, the first after the first cycle
+  for (const protocol::TimingMsg& t : b.timings) {
+    EXPECT_NEAR(t.latency_p50_s, 1000e-6, 1e-9);
+    EXPECT_NEAR(t.latency_p99_s, 1000e-6, 1e-9);
+    EXPECT_NEAR(t.dsp_time_s, 0.0, 1e-9);
+  }
+  // The right pad lost: one pad alone, its arrival both the later and the earlier.
+  shared_.sensors[1].disconnected.store(true);
+  for (std::size_t i = 30; i < 30 + 256; ++i) {
+    const std::int64_t t_left = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
+    push_pad(i, 0, t_left, t_left + 300'000);
+    g_clock_ns = t_left + 300'000 + 900'000;
+    now_ = g_clock_ns;
+    engine_->step(now_);
+  }
+  EXPECT_EQ(engine_->stats().singles, 256u);
+  EXPECT_EQ(l.later_arrival().percentile(50), 900);
+  EXPECT_EQ(l.earlier_arrival().percentile(1), 900);
+  EXPECT_EQ(l.sample().percentile(99), 1200);
 }
 
 // What the viewer reads is the cycle as processed: the counters, the pose as a unit quaternion

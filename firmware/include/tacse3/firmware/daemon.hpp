@@ -12,6 +12,7 @@
 #include "tacse3/config/board_file.hpp"
 #include "tacse3/config/calibration_file.hpp"
 #include "tacse3/firmware/cli.hpp"
+#include "tacse3/firmware/doorbell.hpp"
 #include "tacse3/firmware/engine.hpp"
 #include "tacse3/hal/can/channel.hpp"
 #include "tacse3/hal/can/unix_channel.hpp"
@@ -68,6 +69,11 @@ struct DaemonSummary {
   protocol::Cycle last_cycle;  // the last cycle as sent (quantised)
   std::int64_t latency_p50_us = -1;
   std::int64_t latency_p99_us = -1;
+  // Arrival of the sample's later / earlier frame at its capture thread -> cycle sent.
+  std::int64_t later_arrival_p50_us = -1;
+  std::int64_t later_arrival_p99_us = -1;
+  std::int64_t earlier_arrival_p50_us = -1;
+  std::int64_t earlier_arrival_p99_us = -1;
   std::int64_t dsp_p50_us = -1;
   double streaming_s = 0.0;
   bool have_truth = false;
@@ -143,6 +149,7 @@ class Daemon {
   std::unique_ptr<dsp::DualPipeline> pipeline_;
   std::unique_ptr<std::array<FrameRing, 2>> rings_;
   std::unique_ptr<std::array<CommandRing, 2>> command_rings_;  // [0] CAN RX, [1] local
+  Doorbell doorbell_;  // capture and RX threads -> the DSP thread: work was handed over
   std::unique_ptr<Engine> engine_;
   // The recording being written (--record or START_RECORDING; null: none), owned here and lent
   // to the DSP thread; housekeeping creates and closes it.

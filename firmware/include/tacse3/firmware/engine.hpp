@@ -15,6 +15,7 @@
 #include "tacse3/firmware/recording_mailbox.hpp"
 #include "tacse3/firmware/view_fill.hpp"
 #include "tacse3/hal/camera.hpp"
+#include "tacse3/hal/camera/clock.hpp"
 #include "tacse3/hal/camera/spsc_ring.hpp"
 #include "tacse3/hal/can/channel.hpp"
 #include "tacse3/protocol/codec.hpp"
@@ -25,9 +26,15 @@ namespace tacse3::firmware {
 
 class FrameRecorder;
 
+// A frame as the capture thread hands it on: with the moment it received it from the camera
+// (CLOCK_MONOTONIC), where the arrival latencies start (CycleLatency).
+struct ArrivedFrame {
+  hal::Frame frame;
+  std::int64_t arrival_ns = 0;
+};
 // Capture thread -> DSP thread. 8 frames = 66 ms at 120 Hz, more than the camera has buffers,
 // so the ring never holds the camera back in normal operation.
-using FrameRing = hal::SpscRing<hal::Frame, 8>;
+using FrameRing = hal::SpscRing<ArrivedFrame, 8>;
 // RX thread / housekeeping -> DSP thread: validated commands (or NACK reasons) to answer.
 using CommandRing = hal::SpscRing<protocol::CommandResult, 16>;
 using viewer::CommandMailbox;
@@ -75,6 +82,8 @@ struct EngineConfig {
   // grants less (60 of 120 fps) makes every gap between two cycles "stopped", which allows one
   // more Status per cycle, within the same budget in Status frames per second.
   std::int64_t frame_period_ns = 8'333'333;  // 120 Hz
+  // The clock the DSP time and the send time are read from (tests inject their own).
+  std::int64_t (*clock)() noexcept = &hal::monotonic_ns;
 };
 
 struct EngineStats {
@@ -120,7 +129,12 @@ class Engine {
   const StateOutput& state() const noexcept { return state_; }
   const protocol::Cycle& last_cycle() const noexcept { return last_cycle_; }  // as sent
   const dsp::DualResult& last_result() const noexcept { return result_; }
-  std::int64_t latency_percentile_us(double p) const noexcept { return latency_.percentile(p); }
+  // SampleTime -> cycle handed to the channel (StatusTiming); the arrival latencies are in
+  // latency().
+  std::int64_t latency_percentile_us(double p) const noexcept {
+    return latency_.sample().percentile(p);
+  }
+  const CycleLatency& latency() const noexcept { return latency_; }
   std::int64_t dsp_time_percentile_us(double p) const noexcept { return dsp_time_.percentile(p); }
   std::uint8_t rate_divider() const noexcept { return rate_divider_; }
   bool stream_enabled() const noexcept { return stream_enabled_; }
@@ -129,11 +143,12 @@ class Engine {
  private:
   struct Head {
     PendingFrame pending;
-    hal::Frame frame;
+    ArrivedFrame arrived;
   };
   void refill_heads(std::int64_t now_ns) noexcept;
   void release_head(std::size_t s) noexcept;
   void process(bool use_left, bool use_right, std::int64_t now_ns) noexcept;
+  void emit_cycle(bool use_left, bool use_right, std::int64_t t_ns) noexcept;
   void handle_command(const protocol::CommandResult& r) noexcept;
   bool handle_web_command() noexcept;
   protocol::Ack answer(const protocol::CommandResult& r) noexcept;
@@ -166,7 +181,7 @@ class Engine {
   protocol::CycleFrames cycle_frames_{};
   protocol::Cycle last_cycle_{};
   std::array<dsp::Calibration, 2> base_calibration_{};
-  TimingWindow<> latency_;
+  CycleLatency latency_;
   TimingWindow<> dsp_time_;
   std::int64_t last_t_ns_ = INT64_MIN;
   std::int64_t last_pair_t_ns_ = INT64_MIN;
@@ -192,7 +207,6 @@ class Engine {
   CommandMailbox* web_commands_ = nullptr;
   std::int64_t next_view_ns_ = INT64_MIN;
   std::int64_t last_dsp_us_ = -1;
-  std::int64_t last_latency_us_ = -1;
   protocol::Ack recording_ack_{};  // the START_RECORDING answer waiting for housekeeping
 };
 

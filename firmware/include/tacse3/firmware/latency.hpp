@@ -39,4 +39,43 @@ class TimingWindow {
   std::size_t count_ = 0;
 };
 
+// The latencies of one sent cycle, each into its own window. `sent_ns`: the cycle's last frame
+// handed to the channel (CLOCK_MONOTONIC).
+//  - sample: from the cycle's SampleTime (the later frame's capture timestamp, what the Timestamp
+//    frame carries) -- StatusTiming's LatencyP50/P99, which tacse3-truth subtracts from
+//    arrival - SampleTime (docs/truth.md);
+//  - later / earlier arrival: from the moment the capture thread received the sample's later /
+//    earlier frame from its camera (equal for one pad alone): the firmware's own share.
+// A value outside (0, 10 s) is not a latency (a camera not stamping on CLOCK_MONOTONIC) and is
+// left out of that window.
+class CycleLatency {
+ public:
+  struct Times {
+    std::int64_t sample_ns = 0;
+    std::int64_t later_arrival_ns = 0;
+    std::int64_t earlier_arrival_ns = 0;
+    std::int64_t sent_ns = 0;
+  };
+  void add(const Times& t) noexcept {
+    last_sample_us_ = add_to(sample_, t.sent_ns - t.sample_ns, last_sample_us_);
+    (void)add_to(later_, t.sent_ns - t.later_arrival_ns, -1);
+    (void)add_to(earlier_, t.sent_ns - t.earlier_arrival_ns, -1);
+  }
+  const TimingWindow<>& sample() const noexcept { return sample_; }
+  const TimingWindow<>& later_arrival() const noexcept { return later_; }
+  const TimingWindow<>& earlier_arrival() const noexcept { return earlier_; }
+  std::int64_t last_sample_us() const noexcept { return last_sample_us_; }  // -1: none yet
+
+ private:
+  static std::int64_t add_to(TimingWindow<>& w, std::int64_t ns, std::int64_t last) noexcept {
+    if (ns <= 0 || ns >= 10'000'000'000) return last;
+    w.add(static_cast<std::uint32_t>(ns / 1000));
+    return ns / 1000;
+  }
+  TimingWindow<> sample_;
+  TimingWindow<> later_;
+  TimingWindow<> earlier_;
+  std::int64_t last_sample_us_ = -1;
+};
+
 }  // namespace tacse3::firmware

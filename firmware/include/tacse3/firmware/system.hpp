@@ -19,6 +19,10 @@ struct RealtimeResult {
 // privileges (CAP_SYS_NICE, CAP_IPC_LOCK, RLIMIT_MEMLOCK) are reported in `message`.
 RealtimeResult setup_realtime_thread(int priority, int cpu, std::size_t stack_bytes) noexcept;
 
+// Pins the calling thread to `cpu` (-1: leave it). Returns "" when done (or nothing to do), else
+// one line saying why not (a CPU that does not exist is skipped).
+std::string pin_current_thread(int cpu);
+
 // systemd's notify protocol: libsystemd's sd_notify() when built with it, else the same
 // datagram sent to $NOTIFY_SOCKET directly. Returns false when not under systemd (no socket).
 bool notify(const char* state) noexcept;
