@@ -5,7 +5,9 @@
 // thread; from the earlier frame's) and of the DSP time per sample.
 //   default: the sim board (the simulator renders both pads on the capture threads);
 //   --replay DIR: a tacse3-sim recording replayed by both pads (pre-rendered frames, looping),
-//   the right pad --phase-us after the left.
+//   the right pad --phase-us after the left;
+//   --dsp-priority P: the DSP thread at SCHED_FIFO P, as on the board (needs CAP_SYS_NICE; the
+//   daemon says so when it cannot).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -29,15 +31,19 @@ struct Args {
   double seconds = 3.0;
   std::string replay;  // empty: the sim board
   int phase_us = 1500;
+  int dsp_priority = -1;  // -1: the board's (the sim board: 0, normal scheduling)
 };
 
 int usage() {
-  std::fprintf(stderr,
-               "usage: tacse3_bench_latency [--replay DIR [--phase-us N]] [RUNS=5] [SECONDS=3]\n"
-               "  --replay DIR   a tacse3-sim recording, replayed paced by both pads (looping)\n"
-               "  --phase-us N   the right pad's frames N us after the left's (0..%d, default "
-               "1500)\n",
-               kReplayPairToleranceUs);
+  std::fprintf(
+      stderr,
+      "usage: tacse3_bench_latency [--replay DIR [--phase-us N]] [--dsp-priority P] "
+      "[RUNS=5] [SECONDS=3]\n"
+      "  --replay DIR       a tacse3-sim recording, replayed paced by both pads (looping)\n"
+      "  --phase-us N       the right pad's frames N us after the left's (0..%d, default "
+      "1500)\n"
+      "  --dsp-priority P   the DSP thread at SCHED_FIFO P (1..99), as on the board\n",
+      kReplayPairToleranceUs);
   return 2;
 }
 
@@ -51,6 +57,11 @@ bool parse(int argc, char** argv, Args* a) {
       const long v = std::strtol(argv[++i], &end, 10);
       if (*end != '\0' || v < 0 || v > kReplayPairToleranceUs) return false;
       a->phase_us = static_cast<int>(v);
+    } else if (std::strcmp(argv[i], "--dsp-priority") == 0 && i + 1 < argc) {
+      char* end = nullptr;
+      const long v = std::strtol(argv[++i], &end, 10);
+      if (*end != '\0' || v < 1 || v > 99) return false;
+      a->dsp_priority = static_cast<int>(v);
     } else if (argv[i][0] == '-') {
       return false;
     } else {
@@ -78,6 +89,7 @@ bool make_board(const Args& a, config::BoardConfig* board, std::string* e) {
   }
   board->can.backend = config::CanBackend::kLog;
   board->can.log = "/dev/null";
+  if (a.dsp_priority > 0) board->realtime.dsp_priority = a.dsp_priority;
   if (a.replay.empty()) return true;
   for (std::size_t s = 0; s < 2; ++s) {
     board->sensors[s].backend = config::CameraBackend::kReplay;
