@@ -73,15 +73,20 @@ class EngineTest : public ::testing::Test {
   }
   static void TearDownTestSuite() { delete frames_; }
 
-  void SetUp() override {
-    pipeline_ = std::make_unique<dsp::DualPipeline>();
+  // The engine's pipeline configuration, also for the reference run of the same frames.
+  static void configure(dsp::DualPipeline& p) {
     dsp::DualConfig dual;
     dual.finger_separation_m = separation_m_;
     dsp::Calibration cal;
     cal.pixel_pitch_m = 1e-4;
     cal.c_displacement = 2e-4;
     cal.velocity_proxy = dsp::VelocityProxy::kDisplacement;
-    ASSERT_EQ(pipeline_->configure(dual, {cal, cal}), dsp::Status::kOk);
+    ASSERT_EQ(p.configure(dual, {cal, cal}), dsp::Status::kOk);
+  }
+
+  void SetUp() override {
+    pipeline_ = std::make_unique<dsp::DualPipeline>();
+    configure(*pipeline_);
     EngineConfig ec;
     ec.pairing = pairing_config(2000, 50);
     make_engine(ec);
@@ -557,6 +562,44 @@ TEST_F(EngineTest, LatenciesRunFromTheSampleTimeAndTheFramesArrivals) {
   EXPECT_EQ(l.later_arrival().percentile(50), 900);
   EXPECT_EQ(l.earlier_arrival().percentile(1), 900);
   EXPECT_EQ(l.sample().percentile(99), 1200);
+}
+
+// Pads 1.5 ms apart, the later one arriving first on every other sample and each arriving after
+// a loop iteration found the other alone: the engine waits for the pair, then sends exactly what
+// the dual pipeline gives for the two frames at the later timestamp.
+TEST_F(EngineTest, OffsetPadsGiveTheDualPipelinesOutputBitForBit) {
+  auto reference = std::make_unique<dsp::DualPipeline>();
+  configure(*reference);
+  dsp::DualResult want;
+  for (std::size_t i = 0; i < frame_count(); ++i) {
+    const std::int64_t t_left = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
+    const std::int64_t t_right = t_left + 1'500'000;
+    const std::size_t first = i % 2;  // the pad whose frame is handed over first
+    const std::int64_t t_first = first == 0 ? t_left : t_right;
+    const std::int64_t t_second = first == 0 ? t_right : t_left;
+    push_pad(i, first, t_first, t_right + 100'000);
+    engine_->step(t_right + 100'000);
+    ASSERT_EQ(engine_->stats().samples, i) << "processed without its partner";
+    push_pad(i, 1 - first, t_second, t_right + 200'000);
+    engine_->step(t_right + 200'000);
+    ASSERT_EQ(engine_->stats().pairs, i + 1);
+    const auto& l = (*frames_)[2 * i];
+    const auto& r = (*frames_)[2 * i + 1];
+    const dsp::FrameView lv{l.data(), l.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+    const dsp::FrameView rv{r.data(), r.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+    reference->process(&lv, &rv, t_right, want);
+    const dsp::DualResult& got = engine_->last_result();
+    ASSERT_EQ(got.t_ns, t_right);
+    for (int k = 0; k < 6; ++k) ASSERT_EQ(got.twist[k], want.twist[k]) << i;
+    ASSERT_EQ(got.pose.q.coeffs(), want.pose.q.coeffs()) << i;
+    ASSERT_EQ(got.pose.p, want.pose.p) << i;
+    ASSERT_EQ(got.confidence, want.confidence) << i;
+  }
+  const auto b = decode();
+  ASSERT_EQ(b.cycles.size(), frame_count());
+  EXPECT_EQ(b.cycles.back().timestamp_us,
+            static_cast<std::uint64_t>(engine_->last_result().t_ns / 1000));
+  EXPECT_FALSE(b.cycles.back().single_sensor);
 }
 
 // What the viewer reads is the cycle as processed: the counters, the pose as a unit quaternion
