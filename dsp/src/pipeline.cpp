@@ -72,6 +72,11 @@ Status SensorPipeline::set_calibration(const Calibration& cal) noexcept {
 }
 
 void SensorPipeline::tare() noexcept {
+  tare_image();
+  reset_motion();
+}
+
+void SensorPipeline::tare_image() noexcept {
   if (flow_.has_reference()) {
     // The last processed frame is still in fields_.work: it becomes the reference now, so the
     // very next frame already measures against it.
@@ -82,6 +87,9 @@ void SensorPipeline::tare() noexcept {
   }
   nhhd_.reset();
   contact_.reset();
+}
+
+void SensorPipeline::reset_motion() noexcept {
   motion_.reset();
 }
 
@@ -90,6 +98,13 @@ void SensorPipeline::restart_motion() noexcept {
 }
 
 void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& out) noexcept {
+  PadStages& stages = scratch_;
+  process_image(frame, stages);
+  finish_motion(stages, dt_s, out);
+}
+
+void SensorPipeline::process_image(const FrameView& frame, PadStages& stages) noexcept {
+  SensorResult& out = stages.result;
   out = SensorResult{};
   // Stage 1 (Sec. IV-B): luma and 2x2 downsample. A malformed frame is rejected before any state
   // is touched; check_frame and the conversion share the same rules.
@@ -127,6 +142,14 @@ void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& 
 
   out.processed = true;
   out.degraded = out.tracked_points < min_tracked_points_;
+  stages.contact = fields_.contact;
+  stages.shear = fields_.shear;
+}
+
+void SensorPipeline::finish_motion(const PadStages& stages, double dt_s,
+                                   SensorResult& out) noexcept {
+  out = stages.result;
+  if (!out.processed) return;
   if (out.degraded) {
     // Too little of the pad is trackable (dark, saturated, occluded or unrelated frame): its
     // shear would be stale, so the motion state restarts instead of differentiating across it.
@@ -135,7 +158,7 @@ void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& 
   }
   const double dt = (std::isfinite(dt_s) && dt_s > 0.0 && dt_s <= 1.0) ? dt_s : 1.0 / 120.0;
   // Stages 7-8: centroid translation, velocity proxy, moments and the own-frame ω solve.
-  (void)motion_.update(fields_.contact, fields_.shear, dt, out.motion);
+  (void)motion_.update(stages.contact, stages.shear, dt, out.motion);
   out.slipping = out.motion.slipping;
 }
 
@@ -208,6 +231,18 @@ Status DualPipeline::set_calibration(const std::array<Calibration, 2>& cal) noex
 
 void DualPipeline::process(const FrameView* left, const FrameView* right, std::int64_t t_ns,
                            DualResult& out) noexcept {
+  if (left != nullptr) process_pad(SensorSlot::kLeft, *left, stages_[0]);
+  if (right != nullptr) process_pad(SensorSlot::kRight, *right, stages_[1]);
+  finish(left != nullptr ? &stages_[0] : nullptr, right != nullptr ? &stages_[1] : nullptr, t_ns,
+         out);
+}
+
+void DualPipeline::process_pad(SensorSlot s, const FrameView& frame, PadStages& out) noexcept {
+  sensors_[static_cast<std::size_t>(s)].process_image(frame, out);
+}
+
+void DualPipeline::finish(const PadStages* left, const PadStages* right, std::int64_t t_ns,
+                          DualResult& out) noexcept {
   out.t_ns = t_ns;
   out.present = {left != nullptr, right != nullptr};
 
@@ -226,19 +261,19 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
   have_last_t_ = true;
   out.dt_s = dt;
 
-  const FrameView* frames[2] = {left, right};
+  const PadStages* stages[2] = {left, right};
   const SensorMotion* motions[2] = {nullptr, nullptr};
   for (std::size_t i = 0; i < 2; ++i) {
     SensorResult& r = out.sensors[i];
     out.slipping[i] = false;
-    if (frames[i] == nullptr) {
+    if (stages[i] == nullptr) {
       r = SensorResult{};
       // A sensor that misses a cycle must not difference its next frame against a stale one.
       sensors_[i].restart_motion();
       continue;
     }
     if (gap) sensors_[i].restart_motion();
-    sensors_[i].process(*frames[i], dt, r);
+    sensors_[i].finish_motion(*stages[i], dt, r);
     if (r.processed && !r.degraded) motions[i] = &r.motion;
     out.slipping[i] = r.slipping;
   }
@@ -300,7 +335,12 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
 }
 
 void DualPipeline::tare() noexcept {
-  for (auto& s : sensors_) s.tare();
+  for (auto& s : sensors_) s.tare_image();
+  tare_motion();
+}
+
+void DualPipeline::tare_motion() noexcept {
+  for (auto& s : sensors_) s.reset_motion();
   average_.reset();
   payback_.reset();
   confidence_.reset();

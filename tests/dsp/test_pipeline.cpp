@@ -289,5 +289,56 @@ TEST(PipelineTruth, TranslationDoesNotLeakIntoRotation) {
   EXPECT_LT(std::hypot(fx.pose.p.x(), fx.pose.p.z()), 20e-6);
 }
 
+// The parts of DualPipeline::process as the daemon runs them: each pad's image stages as soon as
+// its frame is there, the left pad's next frame already through them before the current pair is
+// finished, and a tare in its two halves halfway through. Equal to process() bit for bit.
+TEST(PipelineParts, ImageStagesAheadOfTheFinishGiveProcessBitForBit) {
+  const Rendered& r = rotation_about_z();
+  const DualConfig cfg = dual_config(r.scene, FusionMethod::kJoint);
+  const auto cal = calibration(VelocityProxy::kAuto);
+  auto serial = std::make_unique<DualPipeline>();
+  auto parts = std::make_unique<DualPipeline>();
+  ASSERT_EQ(serial->configure(cfg, cal), Status::kOk);
+  ASSERT_EQ(parts->configure(cfg, cal), Status::kOk);
+  auto stages = std::make_unique<std::array<PadStages, 3>>();  // left ping-pong, right
+  const std::int64_t period_ns = static_cast<std::int64_t>(1e9 / r.scene.fps);
+  const std::size_t n = r.frames[0].size();
+  const std::size_t tare_at = n / 2;
+  const auto view = [&](int pad, std::size_t f) {
+    return test::frame_view(r.frames[pad][f], PixelFormat::kRgb888);
+  };
+  FrameView first = view(0, 0);
+  parts->process_pad(SensorSlot::kLeft, first, (*stages)[0]);
+  int moving = 0;
+  for (std::size_t f = 0; f < n; ++f) {
+    const FrameView l = view(0, f);
+    const FrameView rt = view(1, f);
+    const std::int64_t t = static_cast<std::int64_t>(f) * period_ns;
+    DualResult a, b;
+    serial->process(&l, &rt, t, a);
+    PadStages& left = (*stages)[f % 2];
+    parts->process_pad(SensorSlot::kRight, rt, (*stages)[2]);
+    if (f + 1 < n && f + 1 != tare_at) {
+      const FrameView next = view(0, f + 1);
+      parts->process_pad(SensorSlot::kLeft, next, (*stages)[(f + 1) % 2]);
+    }
+    parts->finish(&left, &(*stages)[2], t, b);
+    ASSERT_EQ(a.twist, b.twist) << "frame " << f;
+    ASSERT_EQ(a.pose.p, b.pose.p) << "frame " << f;
+    ASSERT_EQ(a.pose.q.coeffs(), b.pose.q.coeffs()) << "frame " << f;
+    ASSERT_EQ(a.confidence, b.confidence) << "frame " << f;
+    moving += a.twist.norm() > 0.0 ? 1 : 0;
+    if (f + 1 == tare_at) {
+      serial->tare();
+      parts->sensor_mut(SensorSlot::kLeft).tare_image();
+      parts->sensor_mut(SensorSlot::kRight).tare_image();
+      parts->tare_motion();
+      const FrameView next = view(0, f + 1);
+      parts->process_pad(SensorSlot::kLeft, next, (*stages)[(f + 1) % 2]);
+    }
+  }
+  EXPECT_GT(moving, r.scene.motion_frames / 2);  // the comparison saw real motion
+}
+
 }  // namespace
 }  // namespace tacse3::dsp

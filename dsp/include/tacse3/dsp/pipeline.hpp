@@ -66,6 +66,14 @@ struct SensorResult {
   bool slipping = false;
 };
 
+// What stages 7-8 of a frame need from its stages 1-6: their result so far and a copy of the
+// two fields the motion reads, so the image work of the pad's next frame may run meanwhile.
+struct PadStages {
+  SensorResult result{};  // motion and slipping still empty
+  ContactSet contact{};
+  VectorField shear{};
+};
+
 // One sensor: frame → luma → block flow → smoothing → 𝒢 → NHHD → forces → Ω, q → motion.
 // All state lives in the object (≈ 0.6 MB); construct it once (statically or with one allocation
 // at start). process() never allocates, locks or calls the OS.
@@ -86,6 +94,17 @@ class SensorPipeline {
   // configure/tare ignores it). A malformed frame returns its error in out.status and changes
   // nothing. Never NaN, never throws.
   void process(const FrameView& frame, double dt_s, SensorResult& out) noexcept;
+
+  // process() in two calls: stages 1-6 (the image work, no time step; they advance the block
+  // flow's reference, the NHHD warm start and the contact hysteresis) and stages 7-8 (the
+  // motion, which differences against the previous finished frame). finish_motion may run on
+  // another thread than process_image, one frame behind it (PadStages holds what it reads).
+  void process_image(const FrameView& frame, PadStages& out) noexcept;
+  void finish_motion(const PadStages& stages, double dt_s, SensorResult& out) noexcept;
+  // tare() in the same two halves: the image half (reference, warm start, hysteresis) and the
+  // motion half. tare() = both.
+  void tare_image() noexcept;
+  void reset_motion() noexcept;
 
   // Forget the previous frame's motion state (after a gap in the stream or a missed frame) but
   // keep the reference and the displacement proxy's patch anchor (MotionEstimator::restart()).
@@ -110,6 +129,7 @@ class SensorPipeline {
   ContactDetector contact_{};
   MotionEstimator motion_{};
   SensorFields fields_{};
+  PadStages scratch_{};  // process()'s hand-over from stages 1-6 to 7-8
 };
 
 // Configuration of the dual-sensor estimator.
@@ -171,6 +191,22 @@ class DualPipeline {
   void process(const FrameView* left, const FrameView* right, std::int64_t t_ns,
                DualResult& out) noexcept;
 
+  // process() in parts: process_pad runs one sensor's stages 1-6 as soon as its frame is there
+  // (possibly on its own thread: it touches only that sensor's image state); finish runs
+  // stages 7-8 of the pads present (null: no frame this cycle), fusion and SE(3) at the pair's
+  // sample time t_ns. process() is exactly these calls.
+  void process_pad(SensorSlot s, const FrameView& frame, PadStages& out) noexcept;
+  void finish(const PadStages* left, const PadStages* right, std::int64_t t_ns,
+              DualResult& out) noexcept;
+  // The image state of one sensor for a thread that owns it (process_pad, tare_image,
+  // set_calibration).
+  SensorPipeline& sensor_mut(SensorSlot s) noexcept {
+    return sensors_[static_cast<std::size_t>(s)];
+  }
+  // tare() in parts: each sensor's tare_image (by the thread that owns it), then this: the
+  // motion state, the average, the payback and the confidence restart.
+  void tare_motion() noexcept;
+
   void tare() noexcept;        // both sensors re-take the reference; averaging restarts
   void reset_pose() noexcept;  // pose := identity
   Status set_finger_separation(double separation_m) noexcept;
@@ -191,6 +227,7 @@ class DualPipeline {
   SlipPayback payback_{};
   TwistConfidence confidence_{};
   PoseIntegrator integrator_{};
+  std::array<PadStages, 2> stages_{};  // process()'s own stage outputs
   std::int64_t last_t_ns_ = 0;
   bool have_last_t_ = false;
 };
