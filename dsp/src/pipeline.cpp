@@ -341,6 +341,10 @@ void DualPipeline::tare() noexcept {
 
 void DualPipeline::tare_motion() noexcept {
   for (auto& s : sensors_) s.reset_motion();
+  restart_filters();
+}
+
+void DualPipeline::restart_filters() noexcept {
   average_.reset();
   payback_.reset();
   confidence_.reset();

@@ -119,8 +119,19 @@ void Engine::refill_heads(std::int64_t now_ns) noexcept {
       h.pending.arrival_ns = now_ns;
       observed_[s].seen = true;
       observed_[s].last_frame_ns = now_ns;
+      run_image_stages(s);
     }
   }
+}
+
+void Engine::run_image_stages(std::size_t s) noexcept {
+  Head& h = heads_[s];
+  // A present head never becomes late later: a cycle without it is that of an older frame.
+  if (h.pending.t_ns <= last_t_ns_) return;
+  const std::int64_t t0 = config_.clock();
+  pipeline_.process_pad(static_cast<dsp::SensorSlot>(s), h.arrived.frame.view, h.stages);
+  h.stage_us = (config_.clock() - t0) / 1000;
+  h.staged = true;
 }
 
 void Engine::release_head(std::size_t s) noexcept {
@@ -128,6 +139,11 @@ void Engine::release_head(std::size_t s) noexcept {
   if (!h.pending.present) return;
   if (cameras_[s] != nullptr) cameras_[s]->release(h.arrived.frame);
   h.pending.present = false;
+  h.staged = false;
+  if (motion_reset_pending_[s]) {
+    pipeline_.sensor_mut(static_cast<dsp::SensorSlot>(s)).reset_motion();
+    motion_reset_pending_[s] = false;
+  }
 }
 
 void Engine::release_all() noexcept {
@@ -143,6 +159,8 @@ void Engine::release_all() noexcept {
 
 void Engine::apply_pending_calibration() noexcept {
   if (shared_.calibration_flag.load(std::memory_order_acquire) != SharedState::kPending) return;
+  // Not between a frame's image stages and its motion: each frame runs on one calibration.
+  if (heads_[0].staged || heads_[1].staged) return;
   std::array<dsp::Calibration, 2> cal = shared_.calibration;
   // The running proxy mode survives a reload (AUTO keeps meaning "the file's proxy").
   if (velocity_mode_ != protocol::VelocityMode::kAuto) {
@@ -161,7 +179,18 @@ void Engine::apply_pending_calibration() noexcept {
 // pose as relative to the last pose reset or tare, and the next cycle carries PoseReset = 1 so a
 // controller knows the pose jumped (from the CAN command and from the tare button alike).
 void Engine::tare_and_reset_pose() noexcept {
-  pipeline_.tare();
+  // DualPipeline::tare() in parts: a head whose image stages already ran is the last frame
+  // before the tare (the reference is taken from it), so its pad's motion restarts after it.
+  for (std::size_t s = 0; s < 2; ++s) {
+    dsp::SensorPipeline& p = pipeline_.sensor_mut(static_cast<dsp::SensorSlot>(s));
+    p.tare_image();
+    if (heads_[s].staged) {
+      motion_reset_pending_[s] = true;
+    } else {
+      p.reset_motion();
+    }
+  }
+  pipeline_.restart_filters();
   pipeline_.reset_pose();
   pose_reset_pending_ = true;
 }
@@ -331,10 +360,16 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   for (std::size_t s = 0; s < 2; ++s) {
     if (s == 0 ? use_left : use_right) t_ns = std::max(t_ns, heads_[s].pending.t_ns);
   }
+  const dsp::PadStages* stages[2] = {use_left ? &heads_[0].stages : nullptr,
+                                     use_right ? &heads_[1].stages : nullptr};
   const std::int64_t t0 = config_.clock();
-  pipeline_.process(l, r, t_ns, result_);
-  const std::int64_t t1 = config_.clock();
-  last_dsp_us_ = std::clamp<std::int64_t>((t1 - t0) / 1000, 0, UINT32_MAX);
+  pipeline_.finish(stages[0], stages[1], t_ns, result_);
+  // The pipeline time of the sample: its frames' image stages and the finish.
+  std::int64_t dsp_ns = config_.clock() - t0;
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (stages[s] != nullptr) dsp_ns += heads_[s].stage_us * 1000;
+  }
+  last_dsp_us_ = std::clamp<std::int64_t>(dsp_ns / 1000, 0, UINT32_MAX);
   dsp_time_.add(static_cast<std::uint32_t>(last_dsp_us_));
 #if TACSE3_HAVE_RECORDER
   if (recorder_ != nullptr) recorder_->record(t_ns, l, r);

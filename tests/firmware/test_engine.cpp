@@ -602,6 +602,142 @@ TEST_F(EngineTest, OffsetPadsGiveTheDualPipelinesOutputBitForBit) {
   EXPECT_FALSE(b.cycles.back().single_sensor);
 }
 
+// The earlier pad's image stages run when the loop takes its frame, before the later frame is
+// there: the left pad's image state is that of its newest frame while the right pad's is still
+// the previous one's.
+TEST_F(EngineTest, EarlierPadsImageStagesRunBeforeTheLaterFrameArrives) {
+  auto reference = std::make_unique<dsp::DualPipeline>();
+  configure(*reference);
+  auto stages = std::make_unique<dsp::PadStages>();
+  const auto view = [](std::size_t i, std::size_t s) {
+    const auto& img = (*frames_)[2 * i + s];
+    return dsp::FrameView{img.data(), img.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+  };
+  const auto same_work = [&](dsp::SensorSlot s) {
+    return pipeline_->sensor(s).fields().work.px == reference->sensor(s).fields().work.px;
+  };
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::int64_t t_left = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
+    push_pad(i, 0, t_left, t_left + 100'000);
+    engine_->step(t_left + 100'000);
+    ASSERT_EQ(engine_->stats().samples, i);
+    EXPECT_EQ(pipeline_->sensor(dsp::SensorSlot::kLeft).has_reference(), true);
+    EXPECT_EQ(pipeline_->sensor(dsp::SensorSlot::kRight).has_reference(), i > 0);
+    reference->process_pad(dsp::SensorSlot::kLeft, view(i, 0), *stages);
+    EXPECT_TRUE(same_work(dsp::SensorSlot::kLeft)) << "left frame " << i << " not through stage 1";
+    if (i > 0) {
+      EXPECT_TRUE(same_work(dsp::SensorSlot::kRight)) << "right moved before its frame";
+    }
+    push_pad(i, 1, t_left + 1'500'000, t_left + 1'600'000);
+    engine_->step(t_left + 1'600'000);
+    ASSERT_EQ(engine_->stats().pairs, i + 1);
+    reference->process_pad(dsp::SensorSlot::kRight, view(i, 1), *stages);
+    EXPECT_TRUE(same_work(dsp::SensorSlot::kRight));
+  }
+}
+
+// A tare (or a calibration reload) between the earlier frame's image stages and the later
+// frame: the earlier frame is the last one before it (its pad's reference is taken from it and
+// its motion restarts after it), the later pad's frame the first one after it. Each applies
+// once: the cycles after it equal the reference run's with the same tare, bit for bit.
+TEST_F(EngineTest, TareOrReloadDuringACycleAppliesToEachPadsNextFrameOnce) {
+  auto reference = std::make_unique<dsp::DualPipeline>();
+  configure(*reference);
+  auto stages = std::make_unique<std::array<dsp::PadStages, 2>>();
+  dsp::Calibration reloaded = pipeline_->sensor(dsp::SensorSlot::kLeft).calibration();
+  reloaded.c_displacement *= 2.0;
+  constexpr std::size_t kTareAt = 30, kReloadAt = 45, kEnd = 60;
+  dsp::DualResult want;
+  for (std::size_t i = 0; i < kEnd; ++i) {
+    const std::int64_t t_left = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
+    const std::int64_t t_right = t_left + 1'500'000;
+    const auto& li = (*frames_)[2 * i];
+    const auto& ri = (*frames_)[2 * i + 1];
+    const dsp::FrameView lv{li.data(), li.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+    const dsp::FrameView rv{ri.data(), ri.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+    push_pad(i, 0, t_left, t_left + 100'000);
+    engine_->step(t_left + 100'000);
+    if (i == kTareAt) shared_.tare_requests.fetch_add(1);  // the button, mid-cycle
+    if (i == kReloadAt) {
+      shared_.calibration = {reloaded, reloaded};
+      shared_.calibration_flag.store(SharedState::kPending);
+    }
+    push_pad(i, 1, t_right, t_right + 100'000);
+    engine_->step(t_right + 100'000);
+    ASSERT_EQ(engine_->stats().pairs, i + 1);
+    if (i == kReloadAt) {
+      EXPECT_EQ(shared_.calibration_flag.load(), SharedState::kPending) << "applied mid-frame";
+    }
+    if (i == kReloadAt + 1) {
+      EXPECT_EQ(shared_.calibration_flag.load(), SharedState::kApplied);
+      ASSERT_EQ(reference->set_calibration({reloaded, reloaded}), dsp::Status::kOk);
+    }
+    if (i == kTareAt) {
+      reference->process_pad(dsp::SensorSlot::kLeft, lv, (*stages)[0]);
+      for (dsp::SensorSlot s : {dsp::SensorSlot::kLeft, dsp::SensorSlot::kRight}) {
+        reference->sensor_mut(s).tare_image();
+      }
+      reference->sensor_mut(dsp::SensorSlot::kRight).reset_motion();
+      reference->restart_filters();
+      reference->reset_pose();
+      reference->process_pad(dsp::SensorSlot::kRight, rv, (*stages)[1]);
+      reference->finish(&(*stages)[0], &(*stages)[1], t_right, want);
+      reference->sensor_mut(dsp::SensorSlot::kLeft).reset_motion();
+    } else {
+      reference->process(&lv, &rv, t_right, want);
+    }
+    const dsp::DualResult& got = engine_->last_result();
+    for (int k = 0; k < 6; ++k) ASSERT_EQ(got.twist[k], want.twist[k]) << i;
+    ASSERT_EQ(got.pose.q.coeffs(), want.pose.q.coeffs()) << i;
+    ASSERT_EQ(got.pose.p, want.pose.p) << i;
+  }
+  const auto b = decode();
+  ASSERT_EQ(b.cycles.size(), kEnd);
+  for (std::size_t i = 0; i < kEnd; ++i) EXPECT_EQ(b.cycles[i].pose_reset, i == kTareAt) << i;
+}
+
+// A frame already late when the loop takes it (its pad's partner went alone at a later sample
+// time) is dropped without its image stages: the pad's image state is as if it never came, and
+// the following pairs equal the dual pipeline's on the frames that entered a cycle.
+TEST_F(EngineTest, ALateFrameIsDroppedWithoutItsImageStages) {
+  auto reference = std::make_unique<dsp::DualPipeline>();
+  configure(*reference);
+  dsp::DualResult want;
+  constexpr std::size_t kLate = 10;
+  std::int64_t t = 0;
+  for (std::size_t i = 0; i < 20; ++i) {
+    // After the late frame the loop's clock has run 60 ms ahead: so do the frames.
+    t = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod + (i > kLate ? 70'000'000 : 0);
+    const auto& li = (*frames_)[2 * i];
+    const auto& ri = (*frames_)[2 * i + 1];
+    const dsp::FrameView lv{li.data(), li.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+    const dsp::FrameView rv{ri.data(), ri.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+    if (i != kLate) {
+      push_pad(i, 0, t, t + 100'000);
+      push_pad(i, 1, t, t + 100'000);
+      engine_->step(t + 100'000);
+      reference->process(&lv, &rv, t, want);
+    } else {
+      push_pad(i, 0, t, t + 100'000);
+      engine_->step(t + 100'000);
+      engine_->step(t + 60'000'000);  // past the pairing's 50 ms wait: left alone
+      ASSERT_EQ(engine_->stats().singles, 1u);
+      reference->process(&lv, nullptr, t, want);
+      const auto right = pipeline_->sensor(dsp::SensorSlot::kRight).fields().work.px;
+      const auto switches = pipeline_->sensor(dsp::SensorSlot::kRight).flow().keyframe_switches();
+      push_pad(i, 1, t, t + 60'100'000);
+      engine_->step(t + 60'100'000);
+      ASSERT_EQ(engine_->stats().dropped_late, 1u);
+      EXPECT_TRUE(pipeline_->sensor(dsp::SensorSlot::kRight).fields().work.px == right);
+      EXPECT_EQ(pipeline_->sensor(dsp::SensorSlot::kRight).flow().keyframe_switches(), switches);
+    }
+    const dsp::DualResult& got = engine_->last_result();
+    for (int k = 0; k < 6; ++k) ASSERT_EQ(got.twist[k], want.twist[k]) << i;
+    ASSERT_EQ(got.pose.q.coeffs(), want.pose.q.coeffs()) << i;
+  }
+  EXPECT_EQ(engine_->stats().pairs, 19u);
+}
+
 // What the viewer reads is the cycle as processed: the counters, the pose as a unit quaternion
 // equal to the pipeline's, the pads' images and contact.
 TEST_F(EngineTest, ViewSnapshotCarriesTheLastCycle) {

@@ -206,6 +206,9 @@ class DualPipeline {
   // tare() in parts: each sensor's tare_image (by the thread that owns it), then this: the
   // motion state, the average, the payback and the confidence restart.
   void tare_motion() noexcept;
+  // The pair-level half of tare_motion (average, payback, confidence), for a caller that restarts
+  // a sensor's motion later, after a frame whose image stages ran before the tare.
+  void restart_filters() noexcept;
 
   void tare() noexcept;        // both sensors re-take the reference; averaging restarts
   void reset_pose() noexcept;  // pose := identity

@@ -141,11 +141,19 @@ class Engine {
   protocol::VelocityMode velocity_mode() const noexcept { return velocity_mode_; }
 
  private:
+  // A pad's oldest frame not yet in a cycle. Its image stages (1-6) run when it is taken from
+  // the ring, so a pair's later frame finds the earlier one's done; a frame already late then
+  // (pairing drops it) never runs them, so a pad's image state only sees frames that enter a
+  // cycle, as in DualPipeline::process.
   struct Head {
     PendingFrame pending;
     ArrivedFrame arrived;
+    dsp::PadStages stages;
+    bool staged = false;
+    std::int64_t stage_us = 0;  // time its image stages took
   };
   void refill_heads(std::int64_t now_ns) noexcept;
+  void run_image_stages(std::size_t s) noexcept;
   void release_head(std::size_t s) noexcept;
   void process(bool use_left, bool use_right, std::int64_t now_ns) noexcept;
   void emit_cycle(bool use_left, bool use_right, std::int64_t t_ns) noexcept;
@@ -173,6 +181,9 @@ class Engine {
   SharedState& shared_;
 
   std::array<Head, 2> heads_{};
+  // A tare while a pad's head had its image stages: that frame is the last before the tare, so
+  // the pad's motion restarts once it has been through its cycle (release_head).
+  std::array<bool, 2> motion_reset_pending_{};
   std::array<SensorObservation, 2> observed_{};
   std::array<std::uint64_t, 2> pairing_drops_{};
   StateMachine machine_;
