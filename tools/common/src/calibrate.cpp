@@ -22,6 +22,7 @@
 #include "tacse3/tools/contact_area.hpp"
 #include "tacse3/tools/contact_noise.hpp"
 #include "tacse3/tools/progress.hpp"
+#include "tacse3/tools/rest_persistence.hpp"
 
 namespace tacse3::tools {
 namespace {
@@ -374,36 +375,6 @@ FitResult fit_model(const std::vector<FitData>& data, const FitParams& start) {
   return res;
 }
 
-// How much of the velocity-proxy rate persists once the object is at rest: the mean |ω̄| over the
-// frames after the truth's last motion (|ω_true| < 2 % of its peak), over the mean |ω̄| while
-// it moves. The velocity proxy reads shear as velocity: in the slide regime the shear relaxes
-// when the motion stops (ratio ≈ 0); while the contact sticks the shear is the displacement and
-// stays (ratio ≈ 1 or more). -1 if the recording has no rest after a motion.
-double rest_persistence(const std::vector<Eigen::Vector3d>& est,
-                        const std::vector<dsp::Vector6d>& truth) {
-  const std::size_t n = std::min(est.size(), truth.size());
-  double peak = 0.0;
-  for (std::size_t i = 0; i < n; ++i) peak = std::max(peak, truth[i].head<3>().norm());
-  if (!(peak > 0.0)) return -1.0;
-  std::size_t last_motion = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (truth[i].head<3>().norm() >= 0.02 * peak) last_motion = i;
-  }
-  double moving = 0.0, rest = 0.0;
-  std::size_t nm = 0, nr = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (truth[i].head<3>().norm() >= 0.02 * peak) {
-      moving += est[i].norm();
-      ++nm;
-    } else if (i > last_motion + 12) {  // skip the gel's relaxation (0.1 s at 120 Hz)
-      rest += est[i].norm();
-      ++nr;
-    }
-  }
-  if (nm == 0 || nr < 6 || !(moving > 0.0)) return -1.0;
-  return (rest / static_cast<double>(nr)) / (moving / static_cast<double>(nm));
-}
-
 std::string sim_regime(const std::string& json) {
   const auto at = json.find("\"regime\"");
   if (at == std::string::npos) return {};
@@ -691,8 +662,9 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
   for (std::size_t r = 0; r < n; ++r) {
     const SourceInfo& in = sources[r]->info();
     if (data[r].theta.norm() >= kWeightFloorRad) {
-      const auto tw = truth_twists(in.truth, in.t_ns);
-      const double persist = rest_persistence(out0[r][0].omega, tw);
+      std::vector<Eigen::Quaterniond> tq;
+      for (const std::int64_t t : in.t_ns) tq.push_back(truth_pose_at(in.truth, t).q);
+      const double persist = rest_persistence(out0[r][0].omega, tq);
       rep.recordings[r].rest_persistence = persist;
       if (persist >= 0.0) data[r].preferred = persist < kRestPersistenceMax ? 0 : 1;
     }
