@@ -9,9 +9,10 @@
 # Runs tacse3d for SECONDS on each board, reads /proc/PID/status every second and prints, per
 # board: the peak resident set (VmHWM), the resident set (VmRSS) and the data segment (VmData:
 # heap and anonymous mappings) 2 s after start and at the last sample before the end (a VmData
-# that does not grow after start means no heap growth), and at the end the locked memory
-# (VmLck), the thread count, the resident thread stacks and the anonymous (not file-backed)
-# resident memory; the rest of the resident set is mapped files (the program and its libraries). The replay board plays a tacse3-sim
+# that does not grow after start means no heap growth), and at the end the thread count, the
+# resident thread stacks, the anonymous (not file-backed) resident memory and the rest of the
+# resident set, mapped files (the program and its libraries), and of those the objects the daemon
+# locks in full (the program, libc, libm, libstdc++, libgcc_s, the dynamic loader). The replay board plays a tacse3-sim
 # recording (rendered into a temporary directory, removed at exit) on both pads at its own frame
 # times, looping; the sim board renders both pads live.
 set -euo pipefail
@@ -51,12 +52,21 @@ stacks() {
     END { print sum + 0 }' "/proc/$1/smaps" 2>/dev/null || true
 }
 
+# realtime PID -> KiB resident in the mappings of the objects lock_memory() locks in full.
+realtime() {
+  awk '/^[0-9a-f]+-[0-9a-f]+ / { n = split($NF, p, "/"); f = p[n]
+      rt = (NF >= 6) && (f == "tacse3d" || f ~ /^(libc|libm)\.so/ || f ~ /^libstdc\+\+\.so/ ||
+                         f ~ /^libgcc_s\.so/ || f ~ /^ld-linux/) }
+    $1 == "Rss:" && rt { sum += $2 }
+    END { print sum + 0 }' "/proc/$1/smaps" 2>/dev/null || true
+}
+
 # measure NAME BOARD: runs the daemon, prints one table row.
 measure() {
   local name=$1 board=$2
   "$DAEMON" --board "$board" --seconds "$SECONDS_RUN" --can-log /dev/null --quiet \
     2>"$TMP/$name.err" &
-  local pid=$! t=0 rss_start="" data_start="" rss_end="" data_end="" hwm="" lck="" thr="" stk="" anon=""
+  local pid=$! t=0 rss_start="" data_start="" rss_end="" data_end="" hwm="" thr="" rt="" stk="" anon=""
   while kill -0 "$pid" 2>/dev/null; do
     sleep 1
     t=$((t + 1))
@@ -65,7 +75,7 @@ measure() {
     [ -n "$rss" ] || break
     if [ "$t" -eq 2 ]; then rss_start=$rss data_start=$data; fi
     rss_end=$rss data_end=$data hwm=$peak
-    lck=$(field "$pid" VmLck) thr=$(field "$pid" Threads) stk=$(stacks "$pid")
+    thr=$(field "$pid" Threads) stk=$(stacks "$pid") rt=$(realtime "$pid")
     anon=$(awk '$1 == "Anonymous:" { print $2 }' "/proc/$pid/smaps_rollup" 2>/dev/null || true)
   done
   if ! wait "$pid"; then
@@ -74,7 +84,7 @@ measure() {
     exit 1
   fi
   [ -n "$rss_start" ] || { echo "measure-rss: $name ended before 2 s" >&2; exit 1; }
-  printf "$ROW" "$name" "$hwm" "$rss_start" "$rss_end" "$data_start" "$data_end" "$lck" "$thr" "$stk" "$anon"
+  printf "$ROW" "$name" "$hwm" "$rss_start" "$rss_end" "$data_start" "$data_end" "$thr" "$stk" "$anon" "$((rss_end - anon))" "$rt"
 }
 
 # The replay board: the sim board's file with both pads replaying a recording, paced, looping.
@@ -85,7 +95,7 @@ sed -e "s|^backend = \"sim\"|backend = \"replay\"\ndevice = \"$TMP/rec\"|" \
     boards/sim/board.toml >"$TMP/replay.toml"
 
 echo "tacse3d, $SECONDS_RUN s per board; KiB from /proc/PID/status (start = 2 s after launch)"
-ROW='%-7s %8s %12s %10s %13s %11s %8s %8s %7s %10s\n'
-printf "$ROW" board VmHWM "VmRSS start" "VmRSS end" "VmData start" "VmData end" VmLck threads stacks anonymous
+ROW='%-7s %8s %12s %10s %13s %11s %8s %7s %10s %6s %15s\n'
+printf "$ROW" board VmHWM "VmRSS start" "VmRSS end" "VmData start" "VmData end" threads stacks anonymous files "locked in full"
 measure sim sim
 measure replay "$TMP/replay.toml"

@@ -53,8 +53,8 @@ constexpr int kRxTimeoutMs = 100;
 // (Doorbell); the wait bounds how late a status or a stale pad is noticed.
 constexpr std::int64_t kIdleSleepNs = 200'000;
 constexpr std::size_t kDspStackPrefault = 256 * 1024;
-// Stack sizes (docs/performance.md, "Thread stacks"): mlockall(MCL_FUTURE) keeps every byte of
-// a thread's stack resident, so each thread gets what it was measured to touch, with a margin.
+// Stack sizes (docs/performance.md, "Thread stacks"): memory locking keeps a touched stack page
+// resident, so each thread gets what it was measured to touch, with a margin.
 // DSP: the prefault plus 256 KiB (measured: 12 KiB touched beyond the prefault). Capture and
 // RX: high-water marks of 16 and 8 KiB on the sim and replay boards; 128 KiB leaves 8x for the
 // V4L2 and libcamera paths, which cannot be measured off the board.

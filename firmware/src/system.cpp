@@ -1,11 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 firmware: mlockall / SCHED_FIFO / affinity and the systemd notify protocol.
+// tacse3 firmware: memory locking, SCHED_FIFO, affinity and the systemd notify protocol.
 #include "tacse3/firmware/system.hpp"
 
 #include <alloca.h>
 #include <pthread.h>
 #include <sched.h>
-#include <sys/mman.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
@@ -14,6 +13,8 @@
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+
+#include "tacse3/firmware/memory_lock.hpp"
 
 #if TACSE3_HAVE_LIBSYSTEMD
 #include <systemd/sd-daemon.h>
@@ -24,7 +25,7 @@ namespace tacse3::firmware {
 namespace {
 
 // Touch the stack once so the pages the DSP loop will use are mapped before the first frame
-// (with mlockall(MCL_FUTURE) they then stay resident: no page fault in the loop).
+// (locked at their first touch, lock_memory(): no page fault in the loop).
 __attribute__((noinline)) void prefault_stack(std::size_t bytes) noexcept {
   volatile unsigned char* buf = static_cast<volatile unsigned char*>(alloca(bytes));
   for (std::size_t i = 0; i < bytes; i += 4096) buf[i] = 0;
@@ -51,16 +52,12 @@ std::string pin_current_thread(int cpu) {
 RealtimeResult setup_realtime_thread(int priority, int cpu, std::size_t stack_bytes) noexcept {
   RealtimeResult r;
   std::string missing;
-  // Everything, now and later: the DSP path runs through the program, its libraries, its heap
-  // and its stack, and must take no page fault after start. Locking only those ranges, or
-  // MCL_ONFAULT, would spare untouched pages but let a rarely taken branch fault on the DSP
-  // path. Sized thread stacks (Thread) keep what MCL_FUTURE locks small (docs/performance.md).
-  if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
-    r.locked = true;
-  } else {
-    missing += std::string("mlockall: ") + std::strerror(errno) +
-               " (needs CAP_IPC_LOCK or RLIMIT_MEMLOCK)";
-  }
+  // The DSP path runs through the program, its libraries, its heap and its stack, and must take
+  // no page fault after start: lock_memory() makes those libraries resident in full and locks
+  // every other page at its first touch; the stack prefault below touches the DSP's stack.
+  const MemoryLock lock = lock_memory();
+  r.locked = lock.locked;
+  if (!lock.message.empty()) missing += lock.message;
   if (stack_bytes > 0) prefault_stack(stack_bytes);
   if (priority > 0) {
     sched_param sp{};

@@ -41,8 +41,8 @@ constexpr auto kSamplePoll = std::chrono::milliseconds(10);
 constexpr auto kStreamHeartbeat = std::chrono::seconds(1);
 // The longest the refuser and the listener wait for a connection before looking for a stop.
 constexpr auto kAcceptPoll = std::chrono::milliseconds(100);
-// Stack sizes (docs/performance.md, "Thread stacks"): under the daemon's mlockall(MCL_FUTURE)
-// every byte of a stack is resident. Measured high-water marks while serving the page, every
+// Stack sizes (docs/performance.md, "Thread stacks"): under the daemon's memory locking a
+// touched stack page stays resident. Measured high-water marks while serving the page, every
 // endpoint and an event stream: sampler (JSON, JPEG encoding) 12 KiB, listener 12 KiB, pool
 // threads 20 KiB; 128 KiB leaves at least 6x.
 constexpr std::size_t kSamplerStack = 128 * 1024;

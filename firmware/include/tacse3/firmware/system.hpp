@@ -7,7 +7,7 @@
 namespace tacse3::firmware {
 
 struct RealtimeResult {
-  bool locked = false;     // mlockall(MCL_CURRENT | MCL_FUTURE) succeeded
+  bool locked = false;     // memory locked (lock_memory())
   bool scheduled = false;  // SCHED_FIFO at the priority
   bool pinned = false;     // CPU affinity set
   std::string message;     // one line naming what could not be done and why (empty if all ok)

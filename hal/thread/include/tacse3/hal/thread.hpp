@@ -10,7 +10,8 @@
 namespace tacse3::hal {
 
 // std::thread with the stack size as a required argument (std::thread cannot set one, and the
-// default, RLIMIT_STACK, is 8 MiB: with mlockall(MCL_FUTURE) every byte of it is resident).
+// default, RLIMIT_STACK, is 8 MiB: under the daemon's memory locking a touched page stays
+// resident, and the size bounds how many can be).
 // Sizes are rounded up to whole pages and to at least PTHREAD_STACK_MIN. Like std::thread, a
 // Thread must be joined before it is destroyed (else std::terminate).
 class Thread {

@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: what the daemon keeps resident, and how (docs/performance.md, Memory).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace tacse3::firmware {
+
+// A loaded object (the program or a shared library) and its loadable segments, page-aligned.
+struct LoadedObject {
+  struct Segment {
+    std::uintptr_t begin = 0;
+    std::size_t bytes = 0;
+  };
+  std::string path;  // as the dynamic loader names it ("" for the program itself)
+  std::vector<Segment> segments;
+};
+
+// The loaded objects holding any of `code` (addresses inside them), each once, in load order.
+// Addresses in no loaded object (heap, stack) select nothing.
+std::vector<LoadedObject> objects_containing(std::span<const void* const> code);
+
+// An address in each object the DSP thread runs through: the program (dsp/ and firmware/ are
+// linked into it), libc, libm, libstdc++, libgcc_s and the dynamic loader.
+std::span<const void* const> realtime_code() noexcept;
+
+struct MemoryLock {
+  bool locked = false;         // every page is locked once touched, the real-time objects now
+  std::size_t full_bytes = 0;  // bytes of the real-time objects made resident at start
+  std::string message;         // why not, or what could not be locked (empty if all done)
+};
+
+// Locks the process's memory for the real-time loop: the real-time objects in full and at once
+// (mlock), everything else (heap, stacks, other libraries) page by page as it is first touched
+// (mlockall MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT). A kernel without MCL_ONFAULT (before 4.4)
+// gets everything locked at once. Never fails hard: missing privileges are in `message`.
+MemoryLock lock_memory();
+
+}  // namespace tacse3::firmware
