@@ -13,6 +13,8 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <fstream>
+#include <sstream>
 
 namespace tacse3::firmware {
 
@@ -58,7 +60,59 @@ int visit(dl_phdr_info* info, std::size_t, void* data) {
   return 0;
 }
 
+bool inside(const std::vector<LoadedObject>& objects, std::uintptr_t a) noexcept {
+  for (const LoadedObject& o : objects)
+    for (const LoadedObject::Segment& s : o.segments)
+      if (a >= s.begin && a - s.begin < s.bytes) return true;
+  return false;
+}
+
+// Releases the clean file pages outside `keep`; returns the bytes of the mappings released.
+std::size_t release_clean_pages(const std::vector<LoadedObject>& keep) {
+  std::ifstream f("/proc/self/smaps");
+  std::stringstream text;
+  text << f.rdbuf();
+  std::size_t released = 0;
+  for (const Mapping& m : clean_file_mappings(text.str())) {
+    if (inside(keep, m.begin)) continue;
+    if (madvise(reinterpret_cast<void*>(m.begin), m.end - m.begin, MADV_DONTNEED) == 0)
+      released += m.end - m.begin;
+  }
+  return released;
+}
+
 }  // namespace
+
+std::vector<Mapping> clean_file_mappings(const std::string& smaps) {
+  std::vector<Mapping> all;
+  std::istringstream in(smaps);
+  std::string line;
+  while (std::getline(in, line)) {
+    unsigned long lo = 0, hi = 0;
+    char perms[5] = {};
+    int used = 0;
+    // A mapping's header: "lo-hi perms offset dev inode [path]"; its fields: "Key: value kB".
+    if (std::sscanf(line.c_str(), "%lx-%lx %4s %*s %*s %*s%n", &lo, &hi, perms, &used) == 3 &&
+        used > 0) {
+      Mapping m;
+      m.begin = lo;
+      m.end = hi;
+      m.writable = perms[1] == 'w';
+      const std::size_t path = line.find_first_not_of(' ', static_cast<std::size_t>(used));
+      m.file = path != std::string::npos && line[path] == '/';
+      all.push_back(m);
+      continue;
+    }
+    long kib = 0;
+    if (all.empty()) continue;
+    if (std::sscanf(line.c_str(), "Rss: %ld", &kib) == 1) all.back().rss_kib = kib;
+    if (std::sscanf(line.c_str(), "Anonymous: %ld", &kib) == 1) all.back().anonymous_kib = kib;
+  }
+  std::vector<Mapping> clean;
+  for (const Mapping& m : all)
+    if (m.file && !m.writable && m.anonymous_kib == 0) clean.push_back(m);
+  return clean;
+}
 
 std::vector<LoadedObject> objects_containing(std::span<const void* const> code) {
   std::vector<LoadedObject> out;
@@ -84,6 +138,9 @@ std::span<const void* const> realtime_code() noexcept {
 
 MemoryLock lock_memory() {
   MemoryLock r;
+  const std::vector<LoadedObject> realtime = objects_containing(realtime_code());
+  // Before mlockall: pages of a locked mapping cannot be released.
+  r.released_bytes = release_clean_pages(realtime);
   if (mlockall(MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT) != 0) {
     const int e = errno;
     // EINVAL: a kernel without MCL_ONFAULT. Then everything, now.
@@ -96,7 +153,7 @@ MemoryLock lock_memory() {
     return r;
   }
   r.locked = true;
-  for (const LoadedObject& o : objects_containing(realtime_code())) {
+  for (const LoadedObject& o : realtime) {
     for (const LoadedObject::Segment& s : o.segments) {
       if (mlock(reinterpret_cast<const void*>(s.begin), s.bytes) == 0) {
         r.full_bytes += s.bytes;
