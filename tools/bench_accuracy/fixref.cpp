@@ -100,6 +100,7 @@ int main(int argc, char** argv) {
   std::string cal_in, csv_prefix;
   std::vector<std::string> modes = {"auto", "velocity", "displacement"};
   std::string method = "joint";
+  app.add_option("--profile", c.profile, "sensor profile (tacse3-sim --profile)");
   app.add_option("--object", c.object, "simulator object preset");
   app.add_option("--motion", c.motion, "rx, ry, rz, tx, ty");
   app.add_option("--magnitude", c.magnitude, "deg or mm");
