@@ -217,24 +217,28 @@ void MotionEstimator::restart() noexcept {
   detector_.reset();
 }
 
-Status MotionEstimator::update(const ContactSet& contact, const VectorField& shear, double dt_s,
-                               SensorMotion& out) noexcept {
-  out = SensorMotion{};
-  out.rotation_scale = rotation_scale_;
-  if (!std::isfinite(dt_s) || !(dt_s > 0.0) || dt_s > 1.0) return Status::kBadArgument;
+namespace {
 
-  const bool automatic = mode_ == VelocityProxy::kAuto;
-  const double velocity_scale = c_velocity_ * kQ16Lsb;                 // (m/s) per LSB of shear
-  const double displacement_scale = c_displacement_ * kQ16Lsb / dt_s;  // (m/s) per LSB of Δshear
-  // One pass over Ω: moments (Eq. twist_ls sufficient statistics) of the shear (velocity proxy)
-  // and of its increment (displacement proxy), and the bookkeeping of the translation rules
-  // (intersection with the previous mask).
-  // m: every cell of Ω_t (translation, shear). m_stayed: the cells also in Ω_{t−1}, the only ones
-  // with a shear increment: a cell that (re-)enters Ω was usually not tracked by the flow while
-  // it was out, holds a stale shear, and its first increment would be the whole catch-up at the
-  // patch rim, read as rotation.
-  // m_held: the cells of Ω in the anchor (the velocity proxy's region while the shear is a drag).
-  ContactMoments m, m_stayed, m_anchored, m_held;
+// Mean displacement (m) of n material points from their summed steps (nm); 0 for none.
+Eigen::Vector2d mean_step(std::int64_t dx, std::int64_t dy, std::int64_t n) noexcept {
+  return n > 0 ? Eigen::Vector2d(Eigen::Vector2d(static_cast<double>(dx), static_cast<double>(dy)) /
+                                 static_cast<double>(n) * kNm)
+               : Eigen::Vector2d::Zero();
+}
+
+}  // namespace
+
+// One pass over Ω: moments (Eq. twist_ls sufficient statistics) of the shear (velocity proxy)
+// and of its increment (displacement proxy), and the bookkeeping of the translation rules
+// (intersection with the previous mask).
+// m: every cell of Ω_t (translation, shear). Increments only over the cells also in Ω_{t−1}: a
+// cell that (re-)enters Ω was usually not tracked by the flow while it was out, holds a stale
+// shear, and its first increment would be the whole catch-up at the patch rim, read as rotation.
+// held: the cells of Ω in the anchor (the velocity proxy's region while the shear is a drag).
+MotionEstimator::Pass MotionEstimator::gather(const ContactSet& contact,
+                                              const VectorField& shear) const noexcept {
+  Pass p;
+  ContactMoments m_stayed, m_anchored;
   ProxySums sum_shear, sum_increment, sum_anchored, sum_held;
   const auto add_point = [](ContactMoments& c, std::int64_t x, std::int64_t y, std::int64_t z) {
     ++c.n;
@@ -248,8 +252,6 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     c.syz += y * z;
     c.szz += z * z;
   };
-  std::int64_t common = 0, common_dx = 0, common_dy = 0;
-  std::int64_t anchored_common = 0, anchored_dx = 0, anchored_dy = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(kGridCount); ++i) {
     if (contact.mask.v[i] == 0) continue;
     const std::int64_t x = clamp64(contact.x_nm.v[i], -kMaxPointNm, kMaxPointNm);
@@ -258,106 +260,116 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
     const std::int64_t sx = clamp_proxy(shear.x.v[i]);
     const std::int64_t sy = clamp_proxy(shear.y.v[i]);
     const bool stayed = prev_mask_.v[i] != 0;
-    add_point(m, x, y, z);
+    add_point(p.m, x, y, z);
     sum_shear.add(x, y, z, sx, sy);
     const bool anchored = have_anchor_ && anchor_mask_.v[i] != 0;
     if (anchored) {
-      add_point(m_held, x, y, z);
+      add_point(p.held, x, y, z);
       sum_held.add(x, y, z, sx, sy);
     }
-    if (stayed) {
-      std::int64_t dx = 0, dy = 0;
-      if (have_prev_shear_) {
-        dx = clamp_proxy(static_cast<std::int64_t>(shear.x.v[i]) - prev_shear_.x.v[i]);
-        dy = clamp_proxy(static_cast<std::int64_t>(shear.y.v[i]) - prev_shear_.y.v[i]);
-      }
-      add_point(m_stayed, x, y, z);
-      sum_increment.add(x, y, z, dx, dy);
-      if (anchored) {
-        add_point(m_anchored, x, y, z);
-        sum_anchored.add(x, y, z, dx, dy);
-      }
-      const std::int64_t step_x = x - clamp64(prev_x_nm_.v[i], -kMaxPointNm, kMaxPointNm);
-      const std::int64_t step_y = y - clamp64(prev_y_nm_.v[i], -kMaxPointNm, kMaxPointNm);
-      ++common;
-      common_dx += step_x;
-      common_dy += step_y;
-      if (anchored) {
-        ++anchored_common;
-        anchored_dx += step_x;
-        anchored_dy += step_y;
-      }
+    if (!stayed) continue;
+    std::int64_t dx = 0, dy = 0;
+    if (have_prev_shear_) {
+      dx = clamp_proxy(static_cast<std::int64_t>(shear.x.v[i]) - prev_shear_.x.v[i]);
+      dy = clamp_proxy(static_cast<std::int64_t>(shear.y.v[i]) - prev_shear_.y.v[i]);
+    }
+    add_point(m_stayed, x, y, z);
+    sum_increment.add(x, y, z, dx, dy);
+    if (anchored) {
+      add_point(m_anchored, x, y, z);
+      sum_anchored.add(x, y, z, dx, dy);
+    }
+    const std::int64_t step_x = x - clamp64(prev_x_nm_.v[i], -kMaxPointNm, kMaxPointNm);
+    const std::int64_t step_y = y - clamp64(prev_y_nm_.v[i], -kMaxPointNm, kMaxPointNm);
+    ++p.common;
+    p.common_dx += step_x;
+    p.common_dy += step_y;
+    if (anchored) {
+      ++p.anchored_common;
+      p.anchored_dx += step_x;
+      p.anchored_dy += step_y;
     }
   }
-  out.points = static_cast<int>(m.n);
-  out.contact = m.n > 0;
+  // The proxies' moments: the shear over Ω (velocity) and its increment over Ω_t ∩ Ω_{t−1}.
+  p.shear = p.m;
+  sum_shear.store(p.shear);
+  p.increment = m_stayed;
+  sum_increment.store(p.increment);
+  p.anchored_increment = m_anchored;
+  sum_anchored.store(p.anchored_increment);
+  sum_held.store(p.held);
+  return p;
+}
 
-  // The two proxies' moments: the shear over Ω (velocity) and its increment over Ω_t ∩ Ω_{t−1}.
-  ContactMoments mv = m;
-  sum_shear.store(mv);
-  ContactMoments mi = m_stayed;
-  sum_increment.store(mi);
-  ContactMoments ma = m_anchored;
-  sum_anchored.store(ma);
-  ContactMoments mh = m_held;
-  sum_held.store(mh);
-  // Planar rigid content X of the shear over Ω read as a contact displacement, unsmoothed: the
-  // velocity proxy's region test below, the detector's raw X and the anchor rule all read it.
-  const Eigen::Vector3d shear_content = planar_content(mv, c_displacement_ * kQ16Lsb);
-  // The velocity proxy's region (kVelocityAnchorDragRatio above): Ω ∩ anchor while the shear over
-  // Ω is a drag and Ω and the anchor still share enough cells, else Ω.
-  out.velocity_anchored = velocity_reads_anchor(shear_content, mh.n, anchor_count_, m.n);
-  const ContactMoments& mvel = out.velocity_anchored ? mh : mv;
-  out.velocity_points = static_cast<int>(mvel.n);
-  out.anchor_overlap_points = static_cast<int>(mh.n);
-
-  // --- Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer) and
-  // its relative rate of fall (LoadRelease, docs/dsp/motion.md, release). L_{t−1} is prev_sz_
-  // (kept for the sliding rule).
-  if (m.n > 0) {
-    out.load_drop_rate = release_.update(static_cast<double>(m.sz), prev_count_ > 0,
-                                         static_cast<double>(prev_sz_), dt_s);
+// kAuto: the stick/slip detector on the rigid-body content of the shear and its increment.
+// Returns whether this frame reads the displacement proxy: the regime decided up to the previous
+// frame. Sets *slide_ended when the detector saw a slide end in this frame.
+bool MotionEstimator::decide_proxy(const Pass& p, const Eigen::Vector3d& shear_content, double dt_s,
+                                   bool* slide_ended, SensorMotion& out) noexcept {
+  if (mode_ != VelocityProxy::kAuto) return mode_ == VelocityProxy::kDisplacement;
+  const bool sticking = !detector_.slipping();
+  if (p.m.n == 0) {
+    detector_.reset();  // no contact: the next contact starts sticking (static friction first)
+  } else {
+    const SlipDetector::Step step =
+        detector_.update(shear_content, planar_content(p.increment, c_displacement_ * kQ16Lsb),
+                         out.load_drop_rate, dt_s);
+    const SlipDetector::Features& f = detector_.features();
+    out.shear_shift_m = f.shift_m;
+    out.shear_rate_m_s = f.rate_m_s;
+    out.slip_relax_rate = f.relax_rate;
+    out.slip_onset = step.onset;
+    out.stick_confirmed = step.confirmed;
+    *slide_ended = step.ended;
   }
-  const bool unloading_fast = release_.unloading_fast(out.load_drop_rate);
+  out.slipping = !sticking;
+  return sticking;
+}
 
-  // --- kAuto: the stick/slip detector on the rigid-body content of the shear and its increment.
-  // The proxy of this frame is the one decided up to the previous frame.
-  const bool sticking = automatic ? !detector_.slipping() : mode_ == VelocityProxy::kDisplacement;
-  bool slide_ended = false;
-  if (automatic) {
-    if (m.n == 0) {
-      detector_.reset();  // no contact: the next contact starts sticking (static friction first)
+// The sliding regime's planar step since the last frame: the mask centroid (height-weighted), or
+// the common points' mean step if the mask jumped; none if Ω_t and Ω_{t−1} share no cell.
+MotionEstimator::SlideStep MotionEstimator::slide_step(
+    const Pass& p, double mask_change, const Eigen::Vector3d& centroid) const noexcept {
+  const ContactMoments& m = p.m;
+  SlideStep r;
+  r.point = centroid;
+  // Cells at the rim of Ω carry z ≈ 0, so the cells that flicker in and out of Ω there, and
+  // those the hysteresis keeps in Ω after the patch has moved on, hardly move the weighted
+  // centroid. Without any height (flat contact, height_gain 0) the plain mean.
+  const bool weighted = m.sz > 0 && prev_sz_ > 0;
+  // Area ratio, larger cell count over smaller (exact in double: counts ≤ kGridCount).
+  const std::int64_t larger = std::max(m.n, prev_count_), smaller = std::min(m.n, prev_count_);
+  const bool area_steady =
+      static_cast<double>(larger) <= max_mask_area_ratio_ * static_cast<double>(smaller);
+  if (p.common == 0) {
+    // Unrelated contacts (one vanished as another appeared), not a slide, which moves a patch
+    // by a fraction of its size per frame. No translation.
+  } else if (mask_change <= max_mask_change_ && area_steady) {
+    if (weighted) {
+      const double wt = static_cast<double>(m.sz), wp = static_cast<double>(prev_sz_);
+      r.disp.x() = (static_cast<double>(m.sxz) / wt - static_cast<double>(prev_sxz_) / wp) * kNm;
+      r.disp.y() = (static_cast<double>(m.syz) / wt - static_cast<double>(prev_syz_) / wp) * kNm;
+      r.point =
+          Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sxz), static_cast<double>(m.syz),
+                                          static_cast<double>(m.szz)) *
+                          kNm / static_cast<double>(m.sz));
     } else {
-      const SlipDetector::Step step = detector_.update(
-          shear_content, planar_content(mi, c_displacement_ * kQ16Lsb), out.load_drop_rate, dt_s);
-      const SlipDetector::Features& f = detector_.features();
-      out.shear_shift_m = f.shift_m;
-      out.shear_rate_m_s = f.rate_m_s;
-      out.slip_relax_rate = f.relax_rate;
-      out.slip_onset = step.onset;
-      out.stick_confirmed = step.confirmed;
-      slide_ended = step.ended;
+      const double nt = static_cast<double>(m.n), np = static_cast<double>(prev_count_);
+      r.disp.x() = (static_cast<double>(m.sx) / nt - static_cast<double>(prev_sx_) / np) * kNm;
+      r.disp.y() = (static_cast<double>(m.sy) / nt - static_cast<double>(prev_sy_) / np) * kNm;
     }
-    out.slipping = !sticking;
+    r.source = TranslationSource::kCentroid;
+  } else {
+    r.disp = mean_step(p.common_dx, p.common_dy, p.common);
+    r.source = TranslationSource::kCommonPoints;
   }
+  return r;
+}
 
-  // Final proxy of this frame, and (kAuto while sticking) the velocity proxy's reading beside it.
-  // The displacement proxy reads its increments over the anchored patch: a tangential load
-  // stretches the gel behind the patch, 𝒢 reads the stretch as normal load and Ω grows over gel
-  // that does not move with the object, which would dilute the mean increment more the larger
-  // the motion (docs/dsp/motion.md, patch anchor). Over Ω_t ∩ Ω_{t−1} alone if the anchor and
-  // Ω no longer share a cell.
-  out.velocity_differs = automatic && sticking;
-  out.moments = sticking ? (ma.n > 0 ? ma : mi) : mvel;
-  // A sticking contact whose load falls faster than release_load_rate is being let go: the
-  // displacement proxy's increments are the gel springing back, not the object, so this frame's
-  // chosen reading is dropped (rotation and translation; the velocity reading beside it stays).
-  out.releasing = sticking && out.contact && unloading_fast;
-  out.proxy_valid = (!sticking || have_prev_shear_) && !out.releasing;
-  out.proxy_scale = sticking ? displacement_scale : velocity_scale;
-  out.rotation_scale = sticking ? displacement_rotation_scale_ : rotation_scale_;
-
-  // --- translation: contact-centroid planar displacement (paper Sec. IV-D), t_z = 0.
+// Translation: the contact-centroid planar displacement (paper Sec. IV-D), t_z = 0.
+void MotionEstimator::translate(const Pass& p, bool sticking, double dt_s,
+                                SensorMotion& out) const noexcept {
+  const ContactMoments& m = p.m;
   if (m.n > 0) {
     out.centroid_m =
         Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sx), static_cast<double>(m.sy),
@@ -365,134 +377,95 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
                         kNm) /
         static_cast<double>(m.n);
   }
-  // The sliding rule's centroid is weighted by the contact points' height z (the indentation
-  // estimate): cells at the rim of Ω carry z ≈ 0, so the cells that flicker in and out of Ω
-  // there, and those the hysteresis keeps in Ω after the patch has moved on, hardly move it.
-  // Without any height (flat contact, height_gain 0) the plain mean.
-  const bool weighted = m.sz > 0 && prev_sz_ > 0;
-  const Eigen::Vector3d slide_point =
-      weighted
-          ? Eigen::Vector3d(Eigen::Vector3d(static_cast<double>(m.sxz), static_cast<double>(m.syz),
-                                            static_cast<double>(m.szz)) *
-                            kNm / static_cast<double>(m.sz))
-          : out.centroid_m;
   out.translation_point_m = out.centroid_m;
-  const std::int64_t uni = m.n + prev_count_ - common;
-  out.mask_change = uni > 0 ? 1.0 - static_cast<double>(common) / static_cast<double>(uni) : 1.0;
-  // Area ratio, larger cell count over smaller (exact in double: counts ≤ kGridCount).
-  const std::int64_t larger = std::max(m.n, prev_count_), smaller = std::min(m.n, prev_count_);
-  const bool area_steady =
-      static_cast<double>(larger) <= max_mask_area_ratio_ * static_cast<double>(smaller);
-  if (m.n > 0 && prev_count_ > 0) {
-    // Rule of the sliding regime: mask centroid, or the common points if the mask jumped.
-    Eigen::Vector2d slide_disp = Eigen::Vector2d::Zero();
-    TranslationSource slide_source = TranslationSource::kNone;
-    // Mean displacement (m) of n material points from their summed steps (nm); 0 for none.
-    const auto mean_step = [](std::int64_t dx, std::int64_t dy, std::int64_t n) {
-      return n > 0 ? Eigen::Vector2d(
-                         Eigen::Vector2d(static_cast<double>(dx), static_cast<double>(dy)) /
-                         static_cast<double>(n) * kNm)
-                   : Eigen::Vector2d::Zero();
-    };
-    const Eigen::Vector2d common_disp = mean_step(common_dx, common_dy, common);
-    if (common == 0) {
-      // Ω_t and Ω_{t−1} share no cell: unrelated contacts (one vanished as another appeared),
-      // not a slide, which moves a patch by a fraction of its size per frame. No translation.
-    } else if (out.mask_change <= max_mask_change_ && area_steady) {
-      if (weighted) {
-        const double wt = static_cast<double>(m.sz), wp = static_cast<double>(prev_sz_);
-        slide_disp.x() =
-            (static_cast<double>(m.sxz) / wt - static_cast<double>(prev_sxz_) / wp) * kNm;
-        slide_disp.y() =
-            (static_cast<double>(m.syz) / wt - static_cast<double>(prev_syz_) / wp) * kNm;
-      } else {
-        const double nt = static_cast<double>(m.n), np = static_cast<double>(prev_count_);
-        slide_disp.x() =
-            (static_cast<double>(m.sx) / nt - static_cast<double>(prev_sx_) / np) * kNm;
-        slide_disp.y() =
-            (static_cast<double>(m.sy) / nt - static_cast<double>(prev_sy_) / np) * kNm;
-      }
-      slide_source = TranslationSource::kCentroid;
-    } else {
-      slide_disp = common_disp;
-      slide_source = TranslationSource::kCommonPoints;
-    }
-    Eigen::Vector2d disp = Eigen::Vector2d::Zero();
-    if (sticking && common > 0) {
-      // While the contact sticks the gel material moves with the object, so the mean displacement
-      // of the material points in both masks is the contact displacement itself. The mask
-      // centroid is not used here: a tangential load stretches the gel behind the patch and
-      // compresses it ahead, which moves Ω (read from 𝒢) backwards although nothing slid. For
-      // the same reason the mean is over the anchored patch when it has common points: Ω grows
-      // over stretched gel that lags the object, which would dilute the mean.
-      disp =
-          anchored_common > 0 ? mean_step(anchored_dx, anchored_dy, anchored_common) : common_disp;
-      out.translation_source = TranslationSource::kCommonPoints;
-      out.translation_valid = true;
-    } else if (slide_source != TranslationSource::kNone) {
-      disp = slide_disp;
-      out.translation_source = slide_source;
-      out.translation_valid = true;
-      if (slide_source == TranslationSource::kCentroid) out.translation_point_m = slide_point;
-    }
-    if (out.releasing) {
-      disp.setZero();
-      out.translation_valid = false;
-      out.translation_source = TranslationSource::kNone;
-    }
-    out.translation =
-        translation_scale_.cwiseProduct(Eigen::Vector3d(disp.x(), disp.y(), 0.0) / dt_s);
-    if (out.velocity_differs && slide_source != TranslationSource::kNone) {
-      out.velocity_translation = translation_scale_.cwiseProduct(
-          Eigen::Vector3d(slide_disp.x(), slide_disp.y(), 0.0) / dt_s);
-      out.velocity_translation_valid = true;
-      out.velocity_translation_point_m =
-          slide_source == TranslationSource::kCentroid ? slide_point : out.centroid_m;
-    }
+  const std::int64_t uni = m.n + prev_count_ - p.common;
+  out.mask_change = uni > 0 ? 1.0 - static_cast<double>(p.common) / static_cast<double>(uni) : 1.0;
+  if (m.n == 0 || prev_count_ == 0) return;
+  const SlideStep slide = slide_step(p, out.mask_change, out.centroid_m);
+  Eigen::Vector2d disp = Eigen::Vector2d::Zero();
+  if (sticking && p.common > 0) {
+    // While the contact sticks the gel material moves with the object, so the mean displacement
+    // of the material points in both masks is the contact displacement itself. The mask
+    // centroid is not used here: a tangential load stretches the gel behind the patch and
+    // compresses it ahead, which moves Ω (read from 𝒢) backwards although nothing slid. For
+    // the same reason the mean is over the anchored patch when it has common points: Ω grows
+    // over stretched gel that lags the object, which would dilute the mean.
+    disp = p.anchored_common > 0 ? mean_step(p.anchored_dx, p.anchored_dy, p.anchored_common)
+                                 : mean_step(p.common_dx, p.common_dy, p.common);
+    out.translation_source = TranslationSource::kCommonPoints;
+    out.translation_valid = true;
+  } else if (slide.source != TranslationSource::kNone) {
+    disp = slide.disp;
+    out.translation_source = slide.source;
+    out.translation_valid = true;
+    if (slide.source == TranslationSource::kCentroid) out.translation_point_m = slide.point;
   }
+  if (out.releasing) {
+    disp.setZero();
+    out.translation_valid = false;
+    out.translation_source = TranslationSource::kNone;
+  }
+  out.translation =
+      translation_scale_.cwiseProduct(Eigen::Vector3d(disp.x(), disp.y(), 0.0) / dt_s);
+  if (out.velocity_differs && slide.source != TranslationSource::kNone) {
+    out.velocity_translation = translation_scale_.cwiseProduct(
+        Eigen::Vector3d(slide.disp.x(), slide.disp.y(), 0.0) / dt_s);
+    out.velocity_translation_valid = true;
+    out.velocity_translation_point_m = slide.point;
+  }
+}
 
-  // --- rotation: own-frame shear-only least squares, fixed 3x3 solve.
-  auto solve_rotation = [&](const ContactMoments& sums, double scale,
-                            const Eigen::Vector3d& axis_scale, Solve3Result& result) {
-    const MomentSums ms = to_metric(sums, scale);
-    Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
-    add_normal_equations(ms, AtA, Atb);
-    Solve3Options opt = solve_options_;
-    opt.lambda_abs = ms.n * lever_floor_m_ * lever_floor_m_;
-    result = solve3(AtA, Atb, opt);
-    return Eigen::Vector3d(axis_scale.cwiseProduct(result.x));
-  };
+// Rotation: own-frame shear-only least squares (Eq. twist_ls), fixed 3x3 solve.
+Eigen::Vector3d MotionEstimator::solve_rotation(const ContactMoments& sums, double scale,
+                                                const Eigen::Vector3d& axis_scale,
+                                                Solve3Result& result) const noexcept {
+  const MomentSums ms = to_metric(sums, scale);
+  Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
+  add_normal_equations(ms, AtA, Atb);
+  Solve3Options opt = solve_options_;
+  opt.lambda_abs = ms.n * lever_floor_m_ * lever_floor_m_;
+  result = solve3(AtA, Atb, opt);
+  return Eigen::Vector3d(axis_scale.cwiseProduct(result.x));
+}
+
+// The chosen proxy's rotation and, while kAuto sticks, the velocity proxy's beside it (over
+// `velocity`, read at `velocity_scale`).
+void MotionEstimator::rotate(const ContactMoments& velocity, double velocity_scale,
+                             std::int64_t contact_cells, SensorMotion& out) const noexcept {
   if (out.moments.n > 0 && !out.releasing) {
     out.omega = solve_rotation(out.moments, out.proxy_scale, out.rotation_scale, out.solve);
     out.rotation_valid = out.proxy_valid && out.solve.valid;
   }
   if (out.velocity_differs) {
-    out.velocity_moments = mvel;
+    out.velocity_moments = velocity;
     out.velocity_proxy_scale = velocity_scale;
     out.velocity_rotation_scale = rotation_scale_;
-    if (m.n > 0) {
+    if (contact_cells > 0) {
       out.velocity_omega =
-          solve_rotation(mvel, velocity_scale, rotation_scale_, out.velocity_solve);
+          solve_rotation(velocity, velocity_scale, rotation_scale_, out.velocity_solve);
     }
-  } else {
-    out.velocity_moments = out.moments;
-    out.velocity_proxy_scale = out.proxy_scale;
-    out.velocity_rotation_scale = out.rotation_scale;
-    out.velocity_omega = out.omega;
-    out.velocity_solve = out.solve;
-    out.velocity_translation = out.translation;
-    out.velocity_translation_valid = out.translation_valid;
-    out.velocity_translation_point_m = out.translation_point_m;
+    return;
   }
+  out.velocity_moments = out.moments;
+  out.velocity_proxy_scale = out.proxy_scale;
+  out.velocity_rotation_scale = out.rotation_scale;
+  out.velocity_omega = out.omega;
+  out.velocity_solve = out.solve;
+  out.velocity_translation = out.translation;
+  out.velocity_translation_valid = out.translation_valid;
+  out.velocity_translation_point_m = out.translation_point_m;
+}
 
-  // --- state for the next frame. The anchor follows Ω while the contact is tangentially
-  // unloaded (the grasp: a few µm of planar shear content), from its first frame, and from the
-  // frame a slide ended (the patch is where the slide left it); it stays while a tangential load
-  // is held.
+// State for the next frame. The anchor follows Ω while the contact is tangentially unloaded
+// (the grasp: a few µm of planar shear content), from its first frame, and from the frame a
+// slide ended (the patch is where the slide left it); it stays while a tangential load is held.
+void MotionEstimator::remember(const ContactSet& contact, const VectorField& shear,
+                               const ContactMoments& m, double shear_shift_m, bool slide_ended,
+                               SensorMotion& out) noexcept {
   if (m.n == 0) {
     have_anchor_ = false;
-  } else if (!have_anchor_ || slide_ended || shear_content.norm() <= min_shift_m_) {
+  } else if (!have_anchor_ || slide_ended || shear_shift_m <= min_shift_m_) {
     anchor_mask_ = contact.mask;
     anchor_count_ = m.n;
     have_anchor_ = true;
@@ -509,6 +482,57 @@ Status MotionEstimator::update(const ContactSet& contact, const VectorField& she
   prev_syz_ = m.syz;
   prev_shear_ = shear;
   have_prev_shear_ = true;
+}
+
+Status MotionEstimator::update(const ContactSet& contact, const VectorField& shear, double dt_s,
+                               SensorMotion& out) noexcept {
+  out = SensorMotion{};
+  out.rotation_scale = rotation_scale_;
+  if (!std::isfinite(dt_s) || !(dt_s > 0.0) || dt_s > 1.0) return Status::kBadArgument;
+
+  const double velocity_scale = c_velocity_ * kQ16Lsb;                 // (m/s) per LSB of shear
+  const double displacement_scale = c_displacement_ * kQ16Lsb / dt_s;  // (m/s) per LSB of Δshear
+  const Pass p = gather(contact, shear);
+  out.points = static_cast<int>(p.m.n);
+  out.contact = p.m.n > 0;
+  // Planar rigid content X of the shear over Ω read as a contact displacement, unsmoothed: the
+  // velocity proxy's region test below, the detector's raw X and the anchor rule all read it.
+  const Eigen::Vector3d shear_content = planar_content(p.shear, c_displacement_ * kQ16Lsb);
+  // The velocity proxy's region (kVelocityAnchorDragRatio above): Ω ∩ anchor while the shear over
+  // Ω is a drag and Ω and the anchor still share enough cells, else Ω.
+  out.velocity_anchored = velocity_reads_anchor(shear_content, p.held.n, anchor_count_, p.m.n);
+  const ContactMoments& mvel = out.velocity_anchored ? p.held : p.shear;
+  out.velocity_points = static_cast<int>(mvel.n);
+  out.anchor_overlap_points = static_cast<int>(p.held.n);
+
+  // Normal load L = Σ z over Ω (the height estimate: p ∝ indentation in a thin layer) and its
+  // relative rate of fall (LoadRelease, docs/dsp/motion.md, release).
+  if (p.m.n > 0) {
+    out.load_drop_rate = release_.update(static_cast<double>(p.m.sz), prev_count_ > 0,
+                                         static_cast<double>(prev_sz_), dt_s);
+  }
+  bool slide_ended = false;
+  const bool sticking = decide_proxy(p, shear_content, dt_s, &slide_ended, out);
+
+  // Final proxy of this frame, and (kAuto while sticking) the velocity proxy's reading beside it.
+  // The displacement proxy reads its increments over the anchored patch: a tangential load
+  // stretches the gel behind the patch, 𝒢 reads the stretch as normal load and Ω grows over gel
+  // that does not move with the object, which would dilute the mean increment more the larger
+  // the motion (docs/dsp/motion.md, patch anchor). Over Ω_t ∩ Ω_{t−1} alone if the anchor and
+  // Ω no longer share a cell.
+  out.velocity_differs = mode_ == VelocityProxy::kAuto && sticking;
+  out.moments = sticking ? (p.anchored_increment.n > 0 ? p.anchored_increment : p.increment) : mvel;
+  // A sticking contact whose load falls faster than release_load_rate is being let go: the
+  // displacement proxy's increments are the gel springing back, not the object, so this frame's
+  // chosen reading is dropped (rotation and translation; the velocity reading beside it stays).
+  out.releasing = sticking && out.contact && release_.unloading_fast(out.load_drop_rate);
+  out.proxy_valid = (!sticking || have_prev_shear_) && !out.releasing;
+  out.proxy_scale = sticking ? displacement_scale : velocity_scale;
+  out.rotation_scale = sticking ? displacement_rotation_scale_ : rotation_scale_;
+
+  translate(p, sticking, dt_s, out);
+  rotate(mvel, velocity_scale, p.m.n, out);
+  remember(contact, shear, p.m, shear_content.norm(), slide_ended, out);
   return Status::kOk;
 }
 

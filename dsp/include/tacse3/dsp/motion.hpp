@@ -231,6 +231,35 @@ class MotionEstimator {
                 SensorMotion& out) noexcept;
 
  private:
+  // update()'s steps, in order (dsp/src/motion.cpp).
+  struct Pass {
+    ContactMoments m;                   // Ω_t: points only
+    ContactMoments shear;               // Ω_t with the shear (velocity proxy)
+    ContactMoments increment;           // Ω_t ∩ Ω_{t−1} with the shear's increment
+    ContactMoments anchored_increment;  // the same over the anchored patch
+    ContactMoments held;                // Ω_t ∩ anchor with the shear
+    std::int64_t common = 0, common_dx = 0, common_dy = 0;  // Ω_t ∩ Ω_{t−1}, summed steps (nm)
+    std::int64_t anchored_common = 0, anchored_dx = 0, anchored_dy = 0;
+  };
+  struct SlideStep {
+    Eigen::Vector2d disp = Eigen::Vector2d::Zero();  // m
+    TranslationSource source = TranslationSource::kNone;
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // the point the step was read at
+  };
+  Pass gather(const ContactSet& contact, const VectorField& shear) const noexcept;
+  bool decide_proxy(const Pass& p, const Eigen::Vector3d& shear_content, double dt_s,
+                    bool* slide_ended, SensorMotion& out) noexcept;
+  SlideStep slide_step(const Pass& p, double mask_change,
+                       const Eigen::Vector3d& centroid) const noexcept;
+  void translate(const Pass& p, bool sticking, double dt_s, SensorMotion& out) const noexcept;
+  Eigen::Vector3d solve_rotation(const ContactMoments& sums, double scale,
+                                 const Eigen::Vector3d& axis_scale,
+                                 Solve3Result& result) const noexcept;
+  void rotate(const ContactMoments& velocity, double velocity_scale, std::int64_t contact_cells,
+              SensorMotion& out) const noexcept;
+  void remember(const ContactSet& contact, const VectorField& shear, const ContactMoments& m,
+                double shear_shift_m, bool slide_ended, SensorMotion& out) noexcept;
+
   VelocityProxy mode_ = VelocityProxy::kVelocity;
   double c_velocity_ = 0.0;
   double c_displacement_ = 0.0;
