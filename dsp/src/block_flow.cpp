@@ -462,31 +462,56 @@ Status BlockFlow::configure(const BlockFlowConfig& config) noexcept {
 }
 
 void BlockFlow::tare(const WorkImage& frame) noexcept {
-  // The tare frame keeps its own slot for the whole session (re-anchoring, see re_anchor()).
+  // The tare frame keeps its own pyramid slot and its own level-0 window models for the whole
+  // session (re-anchoring, see re_anchor()).
   build_pyramid(frame, config_.pyramid_levels, pyramid_[kTareSlot]);
   key_index_ = static_cast<int>(kTareSlot);
+  key_coarse_pyramid_ = true;
   cur_index_ = 0;
   key_displacement_ = VectorField{};
   window_flow_ = VectorField{};
   output_ = VectorField{};
   lost_ = GridMask{};
   reanchored_ = GridMask{};
-  take_keyframe();
+  key_level0_is_tare_ = true;
+  build_level0();
+  tare_origin_x_ = window_origin_x_;
+  tare_origin_y_ = window_origin_y_;
+  tare_offset_ = window_offset_;
+  coarse_pending_ = config_.pyramid_levels > 1;
   has_reference_ = true;
   keyframe_switches_ = 0;
   frames_since_keyframe_ = 0;
   last_frame_was_keyframe_ = true;
   for (int i = 0; i < kGridCount; ++i) {
-    frame_valid_.v[static_cast<std::size_t>(i)] = models_[static_cast<std::size_t>(i)].valid;
+    frame_valid_.v[static_cast<std::size_t>(i)] = level_models(0)[i].valid;
   }
   valid_count_ = keyframe_valid_count_;
 }
 
-void BlockFlow::take_keyframe() noexcept {
-  for (int l = 0; l < config_.pyramid_levels; ++l) build_models(l);
+void BlockFlow::build_level0() noexcept {
+  build_models(0);
+  const FlowWindowModel* level0 = level_models(0);
   int count = 0;
-  for (int i = 0; i < kGridCount; ++i) count += models_[static_cast<std::size_t>(i)].valid;
+  for (int i = 0; i < kGridCount; ++i) count += level0[i].valid;
   keyframe_valid_count_ = count;
+  level0_pending_ = false;
+}
+
+void BlockFlow::build_coarse() noexcept {
+  if (!coarse_pending_) return;
+  if (!key_coarse_pyramid_) {
+    extend_pyramid(pyramid_[static_cast<std::size_t>(key_index_)], config_.pyramid_levels);
+    key_coarse_pyramid_ = true;
+  }
+  for (int l = 1; l < config_.pyramid_levels; ++l) build_models(l);
+  coarse_pending_ = false;
+}
+
+void BlockFlow::complete_keyframe() noexcept {
+  if (!has_reference_) return;
+  if (level0_pending_) build_level0();
+  build_coarse();
 }
 
 // Window models of one level at the current keyframe. Each window is placed on its material
@@ -507,9 +532,8 @@ void BlockFlow::build_models(int level) noexcept {
   for (int jy = 0; jy < gh; ++jy) {
     for (int jx = 0; jx < gw; ++jx) {
       const int index = jy * gw + jx;
-      const auto mi = static_cast<std::size_t>(flow_grid_offset(level) + index);
-      FlowWindowModel& m = models_[mi];
-      FlowWindowTemplate& tpl = templates_[mi];
+      FlowWindowModel& m = level_models(level)[index];
+      FlowWindowTemplate& tpl = level_templates(level)[index];
       m = FlowWindowModel{};
       // Keyframe displacement of the block of level-0 points this window stands for (Q16
       // working px), block mean; then in level-l px.
@@ -648,9 +672,8 @@ void BlockFlow::build_models(int level) noexcept {
 // zero-mean residual is too large.
 BlockFlow::WindowResult BlockFlow::track_window(int level, int index, std::int32_t ux,
                                                 std::int32_t uy, int iterations) const noexcept {
-  const auto mi = static_cast<std::size_t>(flow_grid_offset(level) + index);
-  const FlowWindowModel& m = models_[mi];
-  const FlowWindowTemplate& tpl = templates_[mi];
+  const FlowWindowModel& m = level_models(level)[index];
+  const FlowWindowTemplate& tpl = level_templates(level)[index];
   const std::size_t stride = static_cast<std::size_t>(pyramid_stride(level));
   const std::uint16_t* cur = pyramid_[static_cast<std::size_t>(cur_index_)].level(level);
   const std::int32_t max_x = (pyramid_width(level) - kFlowWindow) << kPosFrac;
@@ -833,6 +856,7 @@ int BlockFlow::track_fine(bool retry) noexcept {
   std::int32_t* fx = flow_x_.data();
   std::int32_t* fy = flow_y_.data();
   std::uint8_t* ok = ok_.data();
+  const FlowWindowModel* level0 = level_models(0);
   if (retry) upsample_correction(0);
   int failed = 0;
   for (int i = 0; i < kGridCount; ++i) {
@@ -841,7 +865,7 @@ int BlockFlow::track_fine(bool retry) noexcept {
     ok[i] = 0;
     fx[i] = window_flow_.x.v[ui];
     fy[i] = window_flow_.y.v[ui];
-    if (!models_[ui].valid) continue;
+    if (!level0[ui].valid) continue;
     const std::int32_t cx = retry ? up_x_[ui] : 0;
     const std::int32_t cy = retry ? up_y_[ui] : 0;
     const WindowResult r =
@@ -932,6 +956,7 @@ void BlockFlow::write_output(VectorField& displacement, GridMask& valid) noexcep
   };
 
   centre_ = window_flow_;
+  const FlowWindowModel* level0 = level_models(0);
   for (int pass = 0; pass < kJacobianPasses; ++pass) {
     for (int i = 0; i < kGridCount; ++i) {
       const auto u = static_cast<std::size_t>(i);
@@ -950,8 +975,8 @@ void BlockFlow::write_output(VectorField& displacement, GridMask& valid) noexcep
     for (int i = 0; i < kGridCount; ++i) {
       const auto u = static_cast<std::size_t>(i);
       if (!frame_valid_.v[u]) continue;
-      const auto& px = models_[u].moment_x;
-      const auto& py = models_[u].moment_y;
+      const auto& px = level0[u].moment_x;
+      const auto& py = level0[u].moment_y;
       const auto& j = jacobian_[u];
       const std::int64_t cx = std::int64_t{px[0]} * j[0] + std::int64_t{px[1]} * j[1] +
                               std::int64_t{py[0]} * j[2] + std::int64_t{py[1]} * j[3];
@@ -1014,12 +1039,16 @@ void BlockFlow::maybe_switch_keyframe() noexcept {
     }
   }
   if (th_.reanchor_tolerance_q16 > 0) re_anchor();
-  if (!coarse_built_)
-    extend_pyramid(pyramid_[static_cast<std::size_t>(cur_index_)], config_.pyramid_levels);
   key_index_ = cur_index_;  // the current frame becomes the keyframe
+  key_coarse_pyramid_ = coarse_built_;
   cur_index_ = 1 - cur_index_;
   window_flow_ = VectorField{};
-  take_keyframe();
+  // Its window models are built later (see track()): level 0 at the start of the next frame,
+  // the coarse levels when a coarse pass first needs them or in the frame after that. They
+  // depend only on the keyframe image and displacement, fixed from here on.
+  key_level0_is_tare_ = false;
+  level0_pending_ = true;
+  coarse_pending_ = config_.pyramid_levels > 1;
   ++keyframe_switches_;
   frames_since_keyframe_ = 0;
   last_frame_was_keyframe_ = true;
@@ -1034,8 +1063,8 @@ void BlockFlow::maybe_switch_keyframe() noexcept {
 // of accumulated, and so is a chain that took a wrong match (the direct match is measured
 // against the frame every displacement refers to; the chain is the sum of every interval's
 // matches). Where the appearance has changed too much for a direct match (large
-// deformation, shading), the chained value is kept. Cost: one tare-model build and one level-0
-// pass, on switch frames only.
+// deformation, shading), the chained value is kept. Cost: one level-0 pass against the tare
+// frame's level-0 models (kept since the tare), on switch frames only.
 void BlockFlow::re_anchor() noexcept {
   // What this frame reported stays as it was (held values, valid mask and count). The copies
   // live in member scratch (no large stack frames).
@@ -1050,10 +1079,12 @@ void BlockFlow::re_anchor() noexcept {
   const int reported_count = valid_count_;
   chained = key_displacement_;
   chained_lost = lost_;
-  key_index_ = static_cast<int>(kTareSlot);
   key_displacement_ = VectorField{};
   lost_ = GridMask{};
-  build_models(0);
+  key_level0_is_tare_ = true;
+  window_origin_x_ = tare_origin_x_;
+  window_origin_y_ = tare_origin_y_;
+  window_offset_ = tare_offset_;
   window_flow_ = chained;  // warm start: tare windows sit at the undeformed positions
   track_fine(false);
   output_ = chained;
@@ -1132,11 +1163,14 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
   // failed windows) only run when enough windows failed, e.g. after a jump larger than the
   // convergence range of level 0 (~1-2 px) or on the first frames after a tare; at steady state
   // the warm start is within a fraction of a pixel and level 0 alone converges.
+  // The keyframe's window models are built in bounded pieces (see maybe_switch_keyframe()).
+  if (level0_pending_) build_level0();
   ImagePyramid& cur = pyramid_[static_cast<std::size_t>(cur_index_)];
   build_pyramid(frame, 1, cur);
   coarse_built_ = false;
   const int failed = track_fine(false);
   if (config_.pyramid_levels > 1 && failed >= config_.coarse_trigger) {
+    build_coarse();
     extend_pyramid(cur, config_.pyramid_levels);
     coarse_built_ = true;
     coarse_to_fine();
@@ -1145,6 +1179,7 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
   write_output(displacement, valid);
   ++frames_since_keyframe_;
   last_frame_was_keyframe_ = false;
+  if (frames_since_keyframe_ >= 2) build_coarse();  // the first frame built level 0
   maybe_switch_keyframe();
 }
 

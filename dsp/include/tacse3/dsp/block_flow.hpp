@@ -120,7 +120,7 @@ struct FlowWindowModel {
 // to fine over a [1 3 3 1] pyramid, warm-started from the previous frame, against an adaptive
 // keyframe chained back to the tare (undeformed) frame.
 //
-// The object is large (~1.1 MB, mostly the packed window templates) and allocation-free;
+// The object is large (~1.7 MB, mostly the packed window templates) and allocation-free;
 // construct it once (static storage or one allocation at start-up).
 class BlockFlow {
  public:
@@ -160,15 +160,21 @@ class BlockFlow {
   // Translation of each level-0 window since the keyframe (Q16 working px).
   const VectorField& flow_from_keyframe() const noexcept { return window_flow_; }
 
-  // Stage access for tests and tools.
+  // A keyframe's window models are built in bounded pieces: at a tare level 0 at once and the
+  // coarse levels within two frames; at a switch level 0 at the start of the next track() and
+  // the coarse levels within the frame after (earlier when a coarse pass needs them). This
+  // builds whatever is still pending now (the results are the same).
+  void complete_keyframe() noexcept;
+
+  // Stage access for tests and tools (call complete_keyframe() first).
   const ImagePyramid& keyframe_pyramid() const noexcept {
     return pyramid_[static_cast<std::size_t>(key_index_)];
   }
   const FlowWindowModel& window_model(int level, int index) const noexcept {
-    return models_[static_cast<std::size_t>(flow_grid_offset(level) + index)];
+    return level_models(level)[index];
   }
   const FlowWindowTemplate& window_template(int level, int index) const noexcept {
-    return templates_[static_cast<std::size_t>(flow_grid_offset(level) + index)];
+    return level_templates(level)[index];
   }
 
  private:
@@ -194,8 +200,27 @@ class BlockFlow {
     std::int32_t reanchor_tolerance_q16 = 0;
   };
 
-  void take_keyframe() noexcept;
+  void build_level0() noexcept;
+  void build_coarse() noexcept;  // when pending
   void build_models(int level) noexcept;
+  // The keyframe's models of one level (level 0: the tare frame's own set while the keyframe
+  // is the tare frame, and during re_anchor()).
+  const FlowWindowModel* level_models(int level) const noexcept {
+    return level == 0 && key_level0_is_tare_ ? tare_models_.data()
+                                             : models_.data() + flow_grid_offset(level);
+  }
+  FlowWindowModel* level_models(int level) noexcept {
+    return level == 0 && key_level0_is_tare_ ? tare_models_.data()
+                                             : models_.data() + flow_grid_offset(level);
+  }
+  const FlowWindowTemplate* level_templates(int level) const noexcept {
+    return level == 0 && key_level0_is_tare_ ? tare_templates_.data()
+                                             : templates_.data() + flow_grid_offset(level);
+  }
+  FlowWindowTemplate* level_templates(int level) noexcept {
+    return level == 0 && key_level0_is_tare_ ? tare_templates_.data()
+                                             : templates_.data() + flow_grid_offset(level);
+  }
   WindowResult track_window(int level, int index, std::int32_t ux, std::int32_t uy,
                             int iterations) const noexcept;
   void coarse_to_fine() noexcept;
@@ -214,13 +239,23 @@ class BlockFlow {
   std::uint32_t keyframe_switches_ = 0;
   std::uint32_t frames_since_keyframe_ = 0;
   bool last_frame_was_keyframe_ = false;
-  bool coarse_built_ = false;  // coarse pyramid levels of the current frame exist
+  bool coarse_built_ = false;        // coarse pyramid levels of the current frame exist
+  bool key_coarse_pyramid_ = false;  // coarse pyramid levels of the keyframe exist
+  bool key_level0_is_tare_ = false;  // level_models(0) is the tare frame's set
+  bool level0_pending_ = false;      // the keyframe's level-0 models are still to be built
+  bool coarse_pending_ = false;      // its coarse-level models are still to be built
   int valid_count_ = 0;
   int keyframe_valid_count_ = 0;
 
   std::array<ImagePyramid, 3> pyramid_{};  // two alternating slots + the tare frame
   std::array<FlowWindowModel, kFlowModelCount> models_{};
   std::array<FlowWindowTemplate, kFlowModelCount> templates_{};
+  // The tare frame's level-0 models and window placement (re_anchor() matches against them).
+  std::array<FlowWindowModel, kGridCount> tare_models_{};
+  std::array<FlowWindowTemplate, kGridCount> tare_templates_{};
+  std::array<std::int16_t, kGridCount> tare_origin_x_{};
+  std::array<std::int16_t, kGridCount> tare_origin_y_{};
+  VectorField tare_offset_{};
 
   VectorField key_displacement_{};  // D_key: material displacement at the keyframe (Q16)
   VectorField window_offset_{};     // delta = material position - window centre, keyframe (Q16)
