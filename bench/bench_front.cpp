@@ -120,9 +120,10 @@ BENCHMARK(BM_BlockFlowSteadyCoarseEveryFrame);
 
 // A keyframe-switch frame: the same slowly moving scene as BM_BlockFlowSteady, but with the
 // switch threshold lowered to 0.1 working px so that every frame switches. Each iteration is a
-// normal warm-started frame plus the switch work: the direct re-match against the tare frame
-// (re-anchoring: tare window models + one level-0 pass) and the new keyframe's coarse pyramid,
-// templates and window models of all levels.
+// normal warm-started frame plus the work of two switches: its own direct re-match against the
+// tare frame (re-anchoring: one level-0 pass against the tare frame's kept models) and the
+// level-0 window models of the keyframe the previous iteration took. The coarse levels are never
+// built (no frame needs them, and every keyframe is replaced within a frame).
 void BM_BlockFlowKeyframeSwitch(benchmark::State& state) {
   const WorkImage a =
       test::render_work_image(texture(), test::Warp::identity(), photometric(1, 1.0));
@@ -176,7 +177,7 @@ void BM_BlockFlowJumpFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_BlockFlowJumpFrame);
 
-// Tare alone (gradients + window models of all levels): the extra cost of a switch frame.
+// Tare alone (pyramid + level-0 window models; the coarse levels follow in later frames).
 void BM_BlockFlowTare(benchmark::State& state) {
   const WorkImage a = test::render_work_image(texture(), test::Warp::identity());
   static BlockFlow flow;

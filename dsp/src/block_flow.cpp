@@ -1179,8 +1179,10 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
   write_output(displacement, valid);
   ++frames_since_keyframe_;
   last_frame_was_keyframe_ = false;
-  if (frames_since_keyframe_ >= 2) build_coarse();  // the first frame built level 0
   maybe_switch_keyframe();
+  // The coarse models of a keyframe no coarse pass has needed yet, in its second frame (the first
+  // built level 0), unless this frame replaced it.
+  if (!last_frame_was_keyframe_ && frames_since_keyframe_ >= 2) build_coarse();
 }
 
 }  // namespace tacse3::dsp
