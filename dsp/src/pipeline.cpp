@@ -63,9 +63,19 @@ Status SensorPipeline::configure(const PipelineConfig& config, const Calibration
 }
 
 Status SensorPipeline::set_calibration(const Calibration& cal) noexcept {
+  if (set_image_calibration(cal) != Status::kOk) return Status::kBadCalibration;
+  return set_motion_calibration(cal);
+}
+
+Status SensorPipeline::set_image_calibration(const Calibration& cal) noexcept {
   if (validate(cal) != Status::kOk) return Status::kBadCalibration;
   (void)forces_.configure(cal);
   (void)contact_.configure(cal);
+  return Status::kOk;
+}
+
+Status SensorPipeline::set_motion_calibration(const Calibration& cal) noexcept {
+  if (validate(cal) != Status::kOk) return Status::kBadCalibration;
   (void)motion_.configure(cal);
   cal_ = cal;
   return Status::kOk;
@@ -213,6 +223,13 @@ Status DualPipeline::set_calibration(const std::array<Calibration, 2>& cal) noex
     if (validate(c) != Status::kOk) return Status::kBadCalibration;
   }
   for (std::size_t i = 0; i < sensors_.size(); ++i) (void)sensors_[i].set_calibration(cal[i]);
+  return set_pair_calibration(cal);
+}
+
+Status DualPipeline::set_pair_calibration(const std::array<Calibration, 2>& cal) noexcept {
+  for (const auto& c : cal) {
+    if (validate(c) != Status::kOk) return Status::kBadCalibration;
+  }
   if (cal[0].moving_average_length != average_.length()) {
     (void)average_.set_length(cal[0].moving_average_length);
   }
@@ -376,7 +393,14 @@ Status DualPipeline::set_velocity_proxy(VelocityProxy mode) noexcept {
   }
   std::array<Calibration, 2> cal = cal_;
   for (auto& c : cal) c.velocity_proxy = mode;
-  return set_calibration(cal);
+  if (set_pair_calibration(cal) != Status::kOk) return Status::kBadCalibration;
+  // Each sensor keeps its own calibration (it may be a reload behind the pair level).
+  for (auto& s : sensors_) {
+    Calibration c = s.calibration();
+    c.velocity_proxy = mode;
+    (void)s.set_motion_calibration(c);
+  }
+  return Status::kOk;
 }
 
 }  // namespace tacse3::dsp

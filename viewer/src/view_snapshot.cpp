@@ -20,6 +20,10 @@ void fill_view_pad(const dsp::SensorPipeline& p, const dsp::SensorResult& r, boo
   out->slipping = present && r.slipping;
   out->contact_area_m2 = present ? contact_area_m2(p) : 0.0;
   out->tracked_fraction = present ? static_cast<double>(r.tracked_points) / dsp::kGridCount : 0.0;
+  fill_view_pad_fields(f, out);
+}
+
+void fill_view_pad_fields(const dsp::SensorFields& f, ViewPad* out) noexcept {
   // Working luma is U8.2 (luma * 4).
   for (std::size_t i = 0; i < out->luma.size(); ++i)
     out->luma[i] = static_cast<std::uint8_t>(std::min<int>(f.work.px[i] >> 2, 255));
@@ -32,10 +36,13 @@ void fill_view_pad(const dsp::SensorPipeline& p, const dsp::SensorResult& r, boo
 }
 
 double contact_area_m2(const dsp::SensorPipeline& p) noexcept {
-  const auto& cal = p.calibration();
+  return contact_area_m2(p.calibration(), p.fields().contact.count);
+}
+
+double contact_area_m2(const dsp::Calibration& cal, int contact_cells) noexcept {
   const double cell_m =
       cal.pixel_pitch_m * (static_cast<double>(dsp::kSensorWidth) / dsp::kGridWidth);
-  return static_cast<double>(p.fields().contact.count) * cell_m * cell_m * cal.pixel_aspect_y;
+  return static_cast<double>(contact_cells) * cell_m * cell_m * cal.pixel_aspect_y;
 }
 
 }  // namespace tacse3::viewer

@@ -85,6 +85,11 @@ class SensorPipeline {
   Status configure(const PipelineConfig& config, const Calibration& cal) noexcept;
   // Applies a new calibration without dropping the reference (e.g. a SIGHUP reload).
   Status set_calibration(const Calibration& cal) noexcept;
+  // set_calibration() in the halves process_image and finish_motion read, for a caller that runs
+  // them on different threads: the image half (force map, contact detector) and the motion half
+  // (motion estimator, calibration()). Each validates; on error nothing changes.
+  Status set_image_calibration(const Calibration& cal) noexcept;
+  Status set_motion_calibration(const Calibration& cal) noexcept;
 
   // Tare: the current (last processed) frame becomes the undeformed reference; before any frame,
   // the next frame does. Clears the NHHD warm start, the contact hysteresis and motion history.
@@ -183,6 +188,10 @@ class DualPipeline {
   // length is the left calibration's. On error nothing changes.
   Status configure(const DualConfig& config, const std::array<Calibration, 2>& cal) noexcept;
   Status set_calibration(const std::array<Calibration, 2>& cal) noexcept;
+  // The pair-level part of set_calibration (average length, payback, confidence), for a caller
+  // that applies each sensor's halves itself (SensorPipeline::set_image_calibration and
+  // set_motion_calibration, on the threads that own them).
+  Status set_pair_calibration(const std::array<Calibration, 2>& cal) noexcept;
 
   // Processes one frame pair. A null frame pointer means that sensor has no frame this cycle
   // (lost, stale or absent): the other sensor carries on alone and the result says so.
@@ -214,6 +223,7 @@ class DualPipeline {
   void reset_pose() noexcept;  // pose := identity
   Status set_finger_separation(double separation_m) noexcept;
   Status set_fusion_method(FusionMethod method) noexcept;
+  // Touches the motion half and the pair level only (the image stages do not read the proxy).
   Status set_velocity_proxy(VelocityProxy mode) noexcept;
 
   const SensorPipeline& sensor(SensorSlot s) const noexcept {

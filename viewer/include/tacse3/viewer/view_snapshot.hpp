@@ -65,10 +65,14 @@ using ViewSlot = SnapshotSlot<ViewSnapshot>;
 
 // Contact area of one sensor: |Ω| flow-grid cells of (320 / kGridWidth) sensor pixels squared.
 double contact_area_m2(const dsp::SensorPipeline& p) noexcept;
+// The same for |Ω| = contact_cells under calibration cal.
+double contact_area_m2(const dsp::Calibration& cal, int contact_cells) noexcept;
 
 // Fills *out's per-cycle fields (all but configured, health, frames and dropped) from one
 // sensor's pipeline and its last result (bounded copy, no allocation).
 void fill_view_pad(const dsp::SensorPipeline& p, const dsp::SensorResult& r, bool present,
                    ViewPad* out) noexcept;
+// fill_view_pad's grid fields and image (luma, mask, shear, fz), from a frame's fields.
+void fill_view_pad_fields(const dsp::SensorFields& f, ViewPad* out) noexcept;
 
 }  // namespace tacse3::viewer
