@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <time.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 
@@ -59,7 +60,10 @@ constexpr std::size_t kDspStackPrefault = 256 * 1024;
 // RX: high-water marks of 16 and 8 KiB on the sim and replay boards; 128 KiB leaves 8x for the
 // V4L2 and libcamera paths, which cannot be measured off the board.
 constexpr std::size_t kDspStack = kDspStackPrefault + 256 * 1024;
-constexpr std::size_t kCaptureStack = 128 * 1024;
+// A capture thread also runs its pad's image stages: its 16 KiB plus the stages (within the DSP
+// loop's 12 KiB) are prefaulted with a margin, plus the 128 KiB for the camera paths.
+constexpr std::size_t kPadStackPrefault = 64 * 1024;
+constexpr std::size_t kCaptureStack = kPadStackPrefault + 128 * 1024;
 constexpr std::size_t kRxStack = 128 * 1024;
 
 hal::LedState led_state(protocol::State s) noexcept {
@@ -330,7 +334,7 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
   d->gpio_controller_ = std::make_unique<hal::GpioController>(*d->gpio_, timing);
 
   // The engine.
-  d->rings_ = std::make_unique<std::array<FrameRing, 2>>();
+  d->rings_ = std::make_unique<std::array<StagedRing, 2>>();
   d->command_rings_ = std::make_unique<std::array<CommandRing, 2>>();
   EngineConfig ec;
   ec.tx.endpoint = ep;
@@ -344,11 +348,12 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
   ec.frame_period_ns =
       1'000'000'000LL / (board.sensors[0].enabled ? board.sensors[0].fps : board.sensors[1].fps);
   std::array<hal::Camera*, 2> cams{d->cameras_[0].get(), d->cameras_[1].get()};
-  std::array<FrameRing*, 2> rings{board.sensors[0].enabled ? &(*d->rings_)[0] : nullptr,
-                                  board.sensors[1].enabled ? &(*d->rings_)[1] : nullptr};
+  std::array<StagedRing*, 2> rings{board.sensors[0].enabled ? &(*d->rings_)[0] : nullptr,
+                                   board.sensors[1].enabled ? &(*d->rings_)[1] : nullptr};
   d->engine_ = std::make_unique<Engine>(
-      ec, *d->pipeline_, *d->channel_, cams, rings,
+      ec, *d->pipeline_, *d->channel_, cams, std::array<FrameRing*, 2>{},
       std::array<CommandRing*, 2>{&(*d->command_rings_)[0], &(*d->command_rings_)[1]}, d->shared_);
+  d->engine_->set_staged_rings(rings);
 
   // --record DIR: what the DSP thread processes, written off the DSP path (docs/firmware.md).
   if (!options.record_dir.empty()) {
@@ -494,16 +499,25 @@ bool Daemon::reload_calibration(std::string* message) {
   return false;
 }
 
+// The pad's thread: takes its camera's frames, runs their image stages at once (PadStager) and
+// hands them to the DSP thread. It is on the path to the CAN frame, so it runs real-time like
+// the DSP thread (stack prefaulted), on the pad's CPU, one priority below it: where they share
+// a CPU the DSP thread, which finishes the cycle, goes first (a camera that decodes its next
+// frame on this thread, as the replay camera does, must not hold the finish back).
 void Daemon::capture_loop(std::size_t s) {
   hal::Camera& cam = *cameras_[s];
-  FrameRing& ring = (*rings_)[s];
+  StagedRing& ring = (*rings_)[s];
+  PadStager& stager = engine_->stager(s);
   auto& sh = shared_.sensors[s];
   const char* side = s == 0 ? "left" : "right";
   std::uint64_t overflow = 0;
   bool reported_error = false;
   bool reported_bad = false;
-  const std::string pinned = pin_current_thread(board_.realtime.pad_cpus[s]);
-  if (!pinned.empty()) say(1, "sensor %s: capture thread %s", side, pinned.c_str());
+  // The DSP thread, started first, has locked the memory.
+  const int priority = std::max(board_.realtime.dsp_priority - 1, 0);
+  const RealtimeResult rt =
+      setup_realtime_thread(priority, board_.realtime.pad_cpus[s], kPadStackPrefault, false);
+  if (!rt.message.empty()) say(1, "sensor %s: pad thread %s", side, rt.message.c_str());
   while (!stop_.load(std::memory_order_acquire)) {
     ArrivedFrame f;
     const hal::CameraStatus st = cam.next_frame(f.frame, kCaptureTimeoutMs);
@@ -514,16 +528,18 @@ void Daemon::capture_loop(std::size_t s) {
       sh.disconnected.store(false, std::memory_order_release);
       reported_error = false;
       reported_bad = false;
-      bool queued = ring.push(f);
-      while (!queued && backpressure_[s] && !stop_.load(std::memory_order_acquire)) {
+      StagedFrame* slot = ring.back();
+      while (slot == nullptr && backpressure_[s] && !stop_.load(std::memory_order_acquire)) {
         sleep_ns(500'000);  // an unpaced source waits for the loop
-        queued = ring.push(f);
+        slot = ring.back();
       }
-      if (!queued) {
-        // The DSP thread is behind by a whole ring: drop the newest, counted.
+      if (slot == nullptr) {
+        // The DSP thread is behind by a whole ring: drop the newest, counted, before its stages.
         cam.release(f.frame);
         ++overflow;
       } else {
+        stager.stage(f, *slot);
+        ring.commit();
         sh.frames.fetch_add(1, std::memory_order_relaxed);
         doorbell_.ring();
       }

@@ -27,15 +27,6 @@ bool slipping(const R& r) noexcept {
 }
 
 template <typename E>
-constexpr bool has_auto_proxy() noexcept {
-  if constexpr (requires { E::kAuto; }) {
-    return true;
-  } else {
-    return false;
-  }
-}
-
-template <typename E>
 E auto_proxy(E fallback) noexcept {
   if constexpr (requires { E::kAuto; }) {
     return E::kAuto;
@@ -86,6 +77,8 @@ Engine::Engine(const EngineConfig& config, dsp::DualPipeline& pipeline, hal::can
       rings_(rings),
       command_rings_(command_rings),
       shared_(shared),
+      stagers_{{{pipeline.sensor_mut(dsp::SensorSlot::kLeft), config.clock},
+                {pipeline.sensor_mut(dsp::SensorSlot::kRight), config.clock}}},
       machine_(config.health),
       rate_divider_(config.rate_divider),
       stream_enabled_(config.stream_enabled),
@@ -109,87 +102,121 @@ bool Engine::send(const protocol::CanFrame& f) noexcept {
   return false;
 }
 
+// The pad's next frame, staged by its own thread or, from a raw ring, here (null: none).
+StagedFrame* Engine::take_frame(std::size_t s) noexcept {
+  if (staged_rings_[s] != nullptr) return staged_rings_[s]->front();
+  ArrivedFrame a;
+  if (rings_[s] == nullptr || !rings_[s]->pop(a)) return nullptr;
+  stagers_[s].stage(a, inline_frames_[s]);
+  return &inline_frames_[s];
+}
+
 void Engine::refill_heads(std::int64_t now_ns) noexcept {
   for (std::size_t s = 0; s < 2; ++s) {
     Head& h = heads_[s];
-    if (h.pending.present || rings_[s] == nullptr) continue;
-    if (rings_[s]->pop(h.arrived)) {
-      h.pending.present = true;
-      h.pending.t_ns = h.arrived.frame.timestamp_ns;
-      h.pending.arrival_ns = now_ns;
-      observed_[s].seen = true;
-      observed_[s].last_frame_ns = now_ns;
-      run_image_stages(s);
-    }
+    if (h.pending.present) continue;
+    h.f = take_frame(s);
+    if (h.f == nullptr) continue;
+    h.pending.present = true;
+    h.pending.t_ns = h.f->arrived.frame.timestamp_ns;
+    h.pending.arrival_ns = now_ns;
+    observed_[s].seen = true;
+    observed_[s].last_frame_ns = now_ns;
   }
-}
-
-void Engine::run_image_stages(std::size_t s) noexcept {
-  Head& h = heads_[s];
-  // A present head never becomes late later: a cycle without it is that of an older frame.
-  if (h.pending.t_ns <= last_t_ns_) return;
-  const std::int64_t t0 = config_.clock();
-  pipeline_.process_pad(static_cast<dsp::SensorSlot>(s), h.arrived.frame.view, h.stages);
-  h.stage_us = (config_.clock() - t0) / 1000;
-  h.staged = true;
 }
 
 void Engine::release_head(std::size_t s) noexcept {
   Head& h = heads_[s];
   if (!h.pending.present) return;
-  if (cameras_[s] != nullptr) cameras_[s]->release(h.arrived.frame);
+  if (cameras_[s] != nullptr) cameras_[s]->release(h.f->arrived.frame);
+  if (staged_rings_[s] != nullptr) staged_rings_[s]->pop();
   h.pending.present = false;
-  h.staged = false;
-  if (motion_reset_pending_[s]) {
-    pipeline_.sensor_mut(static_cast<dsp::SensorSlot>(s)).reset_motion();
-    motion_reset_pending_[s] = false;
-  }
+  h.f = nullptr;
 }
 
 void Engine::release_all() noexcept {
   for (std::size_t s = 0; s < 2; ++s) {
     release_head(s);
-    if (rings_[s] == nullptr) continue;
-    ArrivedFrame f;
-    while (rings_[s]->pop(f)) {
-      if (cameras_[s] != nullptr) cameras_[s]->release(f.frame);
+    while ((heads_[s].f = take_frame(s)) != nullptr) {
+      heads_[s].pending.present = true;
+      release_head(s);
     }
   }
 }
 
+// The motion half of what the pad's thread applied before staging f (PadStager): a frame staged
+// after a tare restarts the pad's motion, one staged under a new calibration switches its motion
+// to it. The frames staged before keep the old ones.
+void Engine::apply_pad_requests(std::size_t s, const StagedFrame& f) noexcept {
+  dsp::SensorPipeline& p = pipeline_.sensor_mut(static_cast<dsp::SensorSlot>(s));
+  if (f.tare_epoch != motion_tare_epoch_[s]) {
+    p.reset_motion();
+    motion_tare_epoch_[s] = f.tare_epoch;
+  }
+  if (f.calibration_epoch != motion_calibration_epoch_[s]) {
+    dsp::Calibration c = posted_calibration_[s];
+    // The running proxy mode survives a reload (AUTO keeps meaning "the file's proxy").
+    if (velocity_mode_ != protocol::VelocityMode::kAuto) {
+      c.velocity_proxy = to_dsp_proxy(velocity_mode_, c.velocity_proxy);
+    }
+    (void)p.set_motion_calibration(c);  // validated when posted
+    motion_calibration_epoch_[s] = f.calibration_epoch;
+  }
+}
+
+// Posts the pending reload's image half to each pad not posted yet; true once both are.
+bool Engine::post_calibration() noexcept {
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (reload_posted_[s]) continue;
+    // A pad with a frame of its last calibration still ahead of its motion half waits for it.
+    const bool after_taken = motion_calibration_epoch_[s] == posted_calibration_epoch_[s];
+    const std::uint32_t e = stagers_[s].request_calibration(reload_calibration_[s], after_taken);
+    if (e == 0) continue;
+    posted_calibration_epoch_[s] = e;
+    posted_calibration_[s] = reload_calibration_[s];
+    reload_posted_[s] = true;
+  }
+  return reload_posted_[0] && reload_posted_[1];
+}
+
+// Each frame runs on one calibration: the pads take the image half before their next frame's
+// stages, the motion half follows at that frame (apply_pad_requests), the pair level now.
 void Engine::apply_pending_calibration() noexcept {
   if (shared_.calibration_flag.load(std::memory_order_acquire) != SharedState::kPending) return;
-  // Not between a frame's image stages and its motion: each frame runs on one calibration.
-  if (heads_[0].staged || heads_[1].staged) return;
-  std::array<dsp::Calibration, 2> cal = shared_.calibration;
+  if (!reload_started_) {
+    reload_calibration_ = shared_.calibration;
+    const bool valid = dsp::validate(reload_calibration_[0]) == dsp::Status::kOk &&
+                       dsp::validate(reload_calibration_[1]) == dsp::Status::kOk;
+    if (!valid) {
+      shared_.calibration_invalid.store(true, std::memory_order_relaxed);
+      shared_.calibration_flag.store(SharedState::kRejected, std::memory_order_release);
+      return;
+    }
+    reload_started_ = true;
+    reload_posted_ = {false, false};
+  }
+  if (!post_calibration()) return;
+  reload_started_ = false;
+  std::array<dsp::Calibration, 2> cal = reload_calibration_;
   // The running proxy mode survives a reload (AUTO keeps meaning "the file's proxy").
   if (velocity_mode_ != protocol::VelocityMode::kAuto) {
     for (std::size_t s = 0; s < 2; ++s) {
       cal[s].velocity_proxy = to_dsp_proxy(velocity_mode_, cal[s].velocity_proxy);
     }
   }
-  const bool ok = pipeline_.set_calibration(cal) == dsp::Status::kOk;
-  if (ok) base_calibration_ = shared_.calibration;
-  shared_.calibration_invalid.store(!ok, std::memory_order_relaxed);
-  shared_.calibration_flag.store(ok ? SharedState::kApplied : SharedState::kRejected,
-                                 std::memory_order_release);
+  (void)pipeline_.set_pair_calibration(cal);  // validated above
+  base_calibration_ = reload_calibration_;
+  shared_.calibration_invalid.store(false, std::memory_order_relaxed);
+  shared_.calibration_flag.store(SharedState::kApplied, std::memory_order_release);
 }
 
 // A tare re-takes both references, which also restarts the pose: docs/can-protocol.md defines the
 // pose as relative to the last pose reset or tare, and the next cycle carries PoseReset = 1 so a
 // controller knows the pose jumped (from the CAN command and from the tare button alike).
 void Engine::tare_and_reset_pose() noexcept {
-  // DualPipeline::tare() in parts: a head whose image stages already ran is the last frame
-  // before the tare (the reference is taken from it), so its pad's motion restarts after it.
-  for (std::size_t s = 0; s < 2; ++s) {
-    dsp::SensorPipeline& p = pipeline_.sensor_mut(static_cast<dsp::SensorSlot>(s));
-    p.tare_image();
-    if (heads_[s].staged) {
-      motion_reset_pending_[s] = true;
-    } else {
-      p.reset_motion();
-    }
-  }
+  // DualPipeline::tare() in parts: each pad re-takes its reference from its last staged frame
+  // before staging the next, whose cycle restarts the pad's motion (apply_pad_requests).
+  for (PadStager& p : stagers_) (void)p.request_tare();
   pipeline_.restart_filters();
   pipeline_.reset_pose();
   pose_reset_pending_ = true;
@@ -212,14 +239,7 @@ bool Engine::apply(const protocol::Command& c) noexcept {
       // method (which cannot fail for a validated value) second.
       const dsp::VelocityProxy proxy =
           to_dsp_proxy(c.velocity_mode, base_calibration_[0].velocity_proxy);
-      dsp::Status st;
-      if (c.velocity_mode == protocol::VelocityMode::kAuto &&
-          !has_auto_proxy<dsp::VelocityProxy>()) {
-        st = pipeline_.set_calibration(base_calibration_);
-      } else {
-        st = pipeline_.set_velocity_proxy(proxy);
-      }
-      if (st != dsp::Status::kOk) return false;
+      if (pipeline_.set_velocity_proxy(proxy) != dsp::Status::kOk) return false;
       if (pipeline_.set_fusion_method(to_dsp(c.fusion)) != dsp::Status::kOk) return false;
       velocity_mode_ = c.velocity_mode;
       return true;
@@ -353,21 +373,26 @@ protocol::Ack Engine::answer(const protocol::CommandResult& r) noexcept {
 }
 
 void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcept {
-  const dsp::FrameView* l = use_left ? &heads_[0].arrived.frame.view : nullptr;
-  const dsp::FrameView* r = use_right ? &heads_[1].arrived.frame.view : nullptr;
+  const dsp::FrameView* l = use_left ? &heads_[0].f->arrived.frame.view : nullptr;
+  const dsp::FrameView* r = use_right ? &heads_[1].f->arrived.frame.view : nullptr;
   // The sample time of a pair is the later timestamp (docs/firmware.md, Pairing).
   std::int64_t t_ns = INT64_MIN;
   for (std::size_t s = 0; s < 2; ++s) {
     if (s == 0 ? use_left : use_right) t_ns = std::max(t_ns, heads_[s].pending.t_ns);
   }
-  const dsp::PadStages* stages[2] = {use_left ? &heads_[0].stages : nullptr,
-                                     use_right ? &heads_[1].stages : nullptr};
+  const dsp::PadStages* stages[2] = {use_left ? &heads_[0].f->stages : nullptr,
+                                     use_right ? &heads_[1].f->stages : nullptr};
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (stages[s] == nullptr) continue;
+    apply_pad_requests(s, *heads_[s].f);
+    contact_cells_[s] = stages[s]->contact.count;
+  }
   const std::int64_t t0 = config_.clock();
   pipeline_.finish(stages[0], stages[1], t_ns, result_);
   // The pipeline time of the sample: its frames' image stages and the finish.
   std::int64_t dsp_ns = config_.clock() - t0;
   for (std::size_t s = 0; s < 2; ++s) {
-    if (stages[s] != nullptr) dsp_ns += heads_[s].stage_us * 1000;
+    if (stages[s] != nullptr) dsp_ns += heads_[s].f->stage_us * 1000;
   }
   last_dsp_us_ = std::clamp<std::int64_t>(dsp_ns / 1000, 0, UINT32_MAX);
   dsp_time_.add(static_cast<std::uint32_t>(last_dsp_us_));
@@ -376,6 +401,7 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
 #endif
   have_result_ = true;
   last_t_ns_ = t_ns;
+  for (PadStager& p : stagers_) p.set_last_sample(t_ns);
   if (use_left && use_right) last_pair_t_ns_ = t_ns;
   ++stats_.samples;
   (use_left && use_right ? stats_.pairs : stats_.singles) += 1;
@@ -425,8 +451,8 @@ void Engine::emit_cycle(bool use_left, bool use_right, std::int64_t t_ns) noexce
   lt.earlier_arrival_ns = INT64_MAX;
   for (std::size_t s = 0; s < 2; ++s) {
     if (!(s == 0 ? use_left : use_right)) continue;
-    lt.later_arrival_ns = std::max(lt.later_arrival_ns, heads_[s].arrived.arrival_ns);
-    lt.earlier_arrival_ns = std::min(lt.earlier_arrival_ns, heads_[s].arrived.arrival_ns);
+    lt.later_arrival_ns = std::max(lt.later_arrival_ns, heads_[s].f->arrived.arrival_ns);
+    lt.earlier_arrival_ns = std::min(lt.earlier_arrival_ns, heads_[s].f->arrived.arrival_ns);
   }
   latency_.add(lt);
   pose_reset_pending_ = false;
@@ -469,7 +495,8 @@ void Engine::send_status_group() noexcept {
   for (std::size_t s = 0; s < 2; ++s) {
     const auto& p = pipeline_.sensor(static_cast<dsp::SensorSlot>(s));
     const bool present = have_result_ && state_.health[s] == SensorHealth::kOk;
-    const double area = present ? viewer::contact_area_m2(p) : kNaN;
+    const double area =
+        present ? viewer::contact_area_m2(p.calibration(), contact_cells_[s]) : kNaN;
     const double conf =
         present ? static_cast<double>(result_.sensors[s].tracked_points) / dsp::kGridCount : kNaN;
     (s == 0 ? g.contact.area_left_m2 : g.contact.area_right_m2) = area;
@@ -552,6 +579,10 @@ bool Engine::step(std::int64_t now_ns) noexcept {
   // the 10 Hz Status below is never starved by a backlog of frames (a slow core working through
   // 16 queued cycles at 60 ms each would otherwise hold it back for a second). Late-frame drops
   // are cheap and keep looping.
+  // The pads copy the viewer's fields from their next frame once a view is due within a period.
+  if (view_ != nullptr && now_ns + config_.frame_period_ns >= next_view_ns_) {
+    for (PadStager& p : stagers_) p.want_view_fields();
+  }
   bool processed = false;
   for (int guard = 0; guard < 16 && !processed; ++guard) {
     refill_heads(now_ns);
@@ -638,7 +669,11 @@ void Engine::publish_view(std::int64_t now_ns) noexcept {
   v.confidence = have_result_ && result_.valid ? clamp01_or_nan(result_.confidence) : 0.0;
   v.dsp_us = have_result_ ? last_dsp_us_ : -1;
   v.latency_us = latency_.last_sample_us();
-  fill_view_pads(pipeline_, result_, state_, config_.configured, &v);
+  for (std::size_t s = 0; s < 2; ++s) {
+    (void)stagers_[s].take_view_fields(&view_pads_[s], &view_contact_cells_[s]);
+    v.pads[s] = view_pads_[s];
+  }
+  fill_view_pads(pipeline_, result_, state_, config_.configured, view_contact_cells_, &v);
   v.counters.cycles_sent = stats_.cycles_sent;
   v.counters.can_send_failures = stats_.send_failures;
   v.counters.can_tx_dropped = shared_.can_tx_dropped.load(std::memory_order_relaxed);

@@ -49,15 +49,18 @@ std::string pin_current_thread(int cpu) {
   return "pin to CPU " + std::to_string(cpu) + ": " + std::strerror(e);
 }
 
-RealtimeResult setup_realtime_thread(int priority, int cpu, std::size_t stack_bytes) noexcept {
+RealtimeResult setup_realtime_thread(int priority, int cpu, std::size_t stack_bytes,
+                                     bool lock) noexcept {
   RealtimeResult r;
   std::string missing;
   // The DSP path runs through the program, its libraries, its heap and its stack, and must take
   // no page fault after start: lock_memory() makes those libraries resident in full and locks
-  // every other page at its first touch; the stack prefault below touches the DSP's stack.
-  const MemoryLock lock = lock_memory();
-  r.locked = lock.locked;
-  if (!lock.message.empty()) missing += lock.message;
+  // every other page at its first touch; the stack prefault below touches this thread's stack.
+  if (lock) {
+    const MemoryLock m = lock_memory();
+    r.locked = m.locked;
+    if (!m.message.empty()) missing += m.message;
+  }
   if (stack_bytes > 0) prefault_stack(stack_bytes);
   if (priority > 0) {
     sched_param sp{};

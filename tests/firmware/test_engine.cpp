@@ -3,8 +3,11 @@
 // NACK), degraded mode and fault, status frames, and no heap allocation per iteration.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstring>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "alloc/alloc_hooks.hpp"
@@ -23,6 +26,20 @@ constexpr std::int64_t kPeriod = 8'333'333;
 std::int64_t g_clock_ns = 0;
 std::int64_t fake_clock() noexcept {
   return g_clock_ns;
+}
+
+// PadThreadsGiveTheSingleThreadedEnginesPairsBitForBit: the left pad thread's clock holds it
+// inside a frame's image stages (PadStager reads the clock after taking the DSP thread's requests,
+// before the stages) while g_hold is set, and says so in g_in_stages.
+std::atomic<bool> g_hold{false};
+std::atomic<bool> g_in_stages{false};
+thread_local bool tl_left_pad = false;
+std::int64_t holding_clock() noexcept {
+  if (tl_left_pad && g_hold.load()) {
+    g_in_stages.store(true);
+    while (g_hold.load()) std::this_thread::yield();
+  }
+  return 0;
 }
 
 // Records sent frames into storage reserved up front (no allocation while the loop runs).
@@ -638,15 +655,16 @@ TEST_F(EngineTest, EarlierPadsImageStagesRunBeforeTheLaterFrameArrives) {
 
 // A tare (or a calibration reload) between the earlier frame's image stages and the later
 // frame: the earlier frame is the last one before it (its pad's reference is taken from it and
-// its motion restarts after it), the later pad's frame the first one after it. Each applies
-// once: the cycles after it equal the reference run's with the same tare, bit for bit.
+// its motion restarts after it; it finishes on the old calibration), the later pad's frame the
+// first one after it. Each applies once: the cycles after it equal the reference run's with the
+// same tare and reload, bit for bit.
 TEST_F(EngineTest, TareOrReloadDuringACycleAppliesToEachPadsNextFrameOnce) {
   auto reference = std::make_unique<dsp::DualPipeline>();
   configure(*reference);
   auto stages = std::make_unique<std::array<dsp::PadStages, 2>>();
   dsp::Calibration reloaded = pipeline_->sensor(dsp::SensorSlot::kLeft).calibration();
   reloaded.c_displacement *= 2.0;
-  constexpr std::size_t kTareAt = 30, kReloadAt = 45, kEnd = 60;
+  constexpr std::size_t kTareAt = 30, kReloadAt = 12, kEnd = 60;
   dsp::DualResult want;
   for (std::size_t i = 0; i < kEnd; ++i) {
     const std::int64_t t_left = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
@@ -666,11 +684,8 @@ TEST_F(EngineTest, TareOrReloadDuringACycleAppliesToEachPadsNextFrameOnce) {
     engine_->step(t_right + 100'000);
     ASSERT_EQ(engine_->stats().pairs, i + 1);
     if (i == kReloadAt) {
-      EXPECT_EQ(shared_.calibration_flag.load(), SharedState::kPending) << "applied mid-frame";
-    }
-    if (i == kReloadAt + 1) {
+      // Answered at once: no cycle waits for it.
       EXPECT_EQ(shared_.calibration_flag.load(), SharedState::kApplied);
-      ASSERT_EQ(reference->set_calibration({reloaded, reloaded}), dsp::Status::kOk);
     }
     if (i == kTareAt) {
       reference->process_pad(dsp::SensorSlot::kLeft, lv, (*stages)[0]);
@@ -683,6 +698,15 @@ TEST_F(EngineTest, TareOrReloadDuringACycleAppliesToEachPadsNextFrameOnce) {
       reference->process_pad(dsp::SensorSlot::kRight, rv, (*stages)[1]);
       reference->finish(&(*stages)[0], &(*stages)[1], t_right, want);
       reference->sensor_mut(dsp::SensorSlot::kLeft).reset_motion();
+    } else if (i == kReloadAt) {
+      reference->process_pad(dsp::SensorSlot::kLeft, lv, (*stages)[0]);
+      ASSERT_EQ(reference->set_pair_calibration({reloaded, reloaded}), dsp::Status::kOk);
+      ASSERT_EQ(reference->sensor_mut(dsp::SensorSlot::kRight).set_calibration(reloaded),
+                dsp::Status::kOk);
+      reference->process_pad(dsp::SensorSlot::kRight, rv, (*stages)[1]);
+      reference->finish(&(*stages)[0], &(*stages)[1], t_right, want);
+      ASSERT_EQ(reference->sensor_mut(dsp::SensorSlot::kLeft).set_calibration(reloaded),
+                dsp::Status::kOk);
     } else {
       reference->process(&lv, &rv, t_right, want);
     }
@@ -694,6 +718,104 @@ TEST_F(EngineTest, TareOrReloadDuringACycleAppliesToEachPadsNextFrameOnce) {
   const auto b = decode();
   ASSERT_EQ(b.cycles.size(), kEnd);
   for (std::size_t i = 0; i < kEnd; ++i) EXPECT_EQ(b.cycles[i].pose_reset, i == kTareAt) << i;
+}
+
+// Each pad's image stages on its own thread, as the daemon's capture threads run them, with a
+// tare and a calibration reload requested while the left pad's thread is in a frame's stages
+// (the left frame is the last before them, the right frame the first after): every pair equals
+// the single-threaded engine's (stages on the stepping thread, the requests between the two
+// frames) bit for bit.
+TEST_F(EngineTest, PadThreadsGiveTheSingleThreadedEnginesPairsBitForBit) {
+  auto pipeline = std::make_unique<dsp::DualPipeline>();
+  configure(*pipeline);
+  auto channel = std::make_unique<RecordingChannel>();
+  auto shared = std::make_unique<SharedState>();
+  auto inputs = std::make_unique<std::array<FrameRing, 2>>();
+  auto staged = std::make_unique<std::array<StagedRing, 2>>();
+  auto commands = std::make_unique<std::array<CommandRing, 2>>();
+  EngineConfig ec;
+  ec.pairing = pairing_config(2000, 50);
+  ec.clock = &holding_clock;
+  auto threaded = std::make_unique<Engine>(
+      ec, *pipeline, *channel, std::array<hal::Camera*, 2>{}, std::array<FrameRing*, 2>{},
+      std::array<CommandRing*, 2>{&(*commands)[0], &(*commands)[1]}, *shared);
+  threaded->set_staged_rings({&(*staged)[0], &(*staged)[1]});
+  threaded->start(now_);
+  std::atomic<bool> stop{false};
+  const auto pad = [&](std::size_t s) {
+    tl_left_pad = s == 0;
+    ArrivedFrame a;
+    while (!stop.load()) {
+      StagedFrame* slot = (*staged)[s].back();
+      if (slot == nullptr || !(*inputs)[s].pop(a)) {
+        std::this_thread::yield();
+        continue;
+      }
+      threaded->stager(s).stage(a, *slot);
+      (*staged)[s].commit();
+    }
+  };
+  std::thread left(pad, 0), right(pad, 1);
+
+  dsp::Calibration reloaded = pipeline_->sensor(dsp::SensorSlot::kLeft).calibration();
+  reloaded.c_displacement *= 2.0;
+  constexpr std::size_t kTareAt = 20, kReloadAt = 12, kEnd = 40;
+  const auto arrived = [&](std::size_t i, std::size_t s, std::int64_t t_ns) {
+    ArrivedFrame a;
+    const auto& img = (*frames_)[2 * (i % frame_count()) + s];
+    a.frame.view = {img.data(), img.size(), 320, 240, 0, dsp::PixelFormat::kGrey};
+    a.frame.timestamp_ns = t_ns;
+    a.arrival_ns = t_ns + 100'000;
+    return a;
+  };
+  const auto request = [&](std::size_t i, SharedState& sh) {
+    if (i == kTareAt) sh.tare_requests.fetch_add(1);
+    if (i == kReloadAt) {
+      sh.calibration = {reloaded, reloaded};
+      sh.calibration_flag.store(SharedState::kPending);
+    }
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  for (std::size_t i = 0; i < kEnd; ++i) {
+    const std::int64_t t_left = 1'000'000'000 + static_cast<std::int64_t>(i) * kPeriod;
+    const std::int64_t t_right = t_left + 1'500'000;
+    // The single-threaded engine: the requests between the left frame's stages and the right.
+    push_pad(i, 0, t_left, t_left + 100'000);
+    engine_->step(t_left + 100'000);
+    request(i, shared_);
+    push_pad(i, 1, t_right, t_right + 100'000);
+    engine_->step(t_right + 100'000);
+    ASSERT_EQ(engine_->stats().pairs, i + 1);
+    // The threaded one: the requests while the left pad's thread is in the frame's stages.
+    const bool hold = i == kTareAt || i == kReloadAt;
+    g_in_stages.store(false);
+    g_hold.store(hold);
+    ASSERT_TRUE((*inputs)[0].push(arrived(i, 0, t_left)));
+    while (hold && !g_in_stages.load()) std::this_thread::yield();
+    request(i, *shared);
+    threaded->step(t_left + 100'000);
+    if (i == kReloadAt) {
+      EXPECT_EQ(shared->calibration_flag.load(), SharedState::kApplied);
+    }
+    g_hold.store(false);
+    ASSERT_TRUE((*inputs)[1].push(arrived(i, 1, t_right)));
+    while (threaded->stats().pairs < i + 1 && std::chrono::steady_clock::now() < deadline) {
+      threaded->step(t_right + 100'000);
+      std::this_thread::yield();
+    }
+    ASSERT_EQ(threaded->stats().pairs, i + 1);
+    const dsp::DualResult& want = engine_->last_result();
+    const dsp::DualResult& got = threaded->last_result();
+    for (int k = 0; k < 6; ++k) ASSERT_EQ(got.twist[k], want.twist[k]) << i;
+    ASSERT_EQ(got.pose.q.coeffs(), want.pose.q.coeffs()) << i;
+    ASSERT_EQ(got.pose.p, want.pose.p) << i;
+  }
+  stop.store(true);
+  left.join();
+  right.join();
+  threaded->release_all();
+  EXPECT_EQ(threaded->stats().dropped_late, 0u);
+  EXPECT_EQ(threaded->last_cycle().pose_reset, false);
 }
 
 // A frame already late when the loop takes it (its pad's partner went alone at a later sample

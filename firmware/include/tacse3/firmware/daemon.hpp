@@ -147,7 +147,7 @@ class Daemon {
   std::unique_ptr<hal::GpioBackend> gpio_;
   std::unique_ptr<hal::GpioController> gpio_controller_;
   std::unique_ptr<dsp::DualPipeline> pipeline_;
-  std::unique_ptr<std::array<FrameRing, 2>> rings_;
+  std::unique_ptr<std::array<StagedRing, 2>> rings_;           // pad thread -> DSP thread
   std::unique_ptr<std::array<CommandRing, 2>> command_rings_;  // [0] CAN RX, [1] local
   Doorbell doorbell_;  // capture and RX threads -> the DSP thread: work was handed over
   std::unique_ptr<Engine> engine_;

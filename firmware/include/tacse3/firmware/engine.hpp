@@ -11,6 +11,7 @@
 #include "tacse3/dsp/pipeline.hpp"
 #include "tacse3/firmware/health.hpp"
 #include "tacse3/firmware/latency.hpp"
+#include "tacse3/firmware/pad_stager.hpp"
 #include "tacse3/firmware/pairing.hpp"
 #include "tacse3/firmware/recording_mailbox.hpp"
 #include "tacse3/firmware/view_fill.hpp"
@@ -26,15 +27,6 @@ namespace tacse3::firmware {
 
 class FrameRecorder;
 
-// A frame as the capture thread hands it on: with the moment it received it from the camera
-// (CLOCK_MONOTONIC), where the arrival latencies start (CycleLatency).
-struct ArrivedFrame {
-  hal::Frame frame;
-  std::int64_t arrival_ns = 0;
-};
-// Capture thread -> DSP thread. 8 frames = 66 ms at 120 Hz, more than the camera has buffers,
-// so the ring never holds the camera back in normal operation.
-using FrameRing = hal::SpscRing<ArrivedFrame, 8>;
 // RX thread / housekeeping -> DSP thread: validated commands (or NACK reasons) to answer.
 using CommandRing = hal::SpscRing<protocol::CommandResult, 16>;
 using viewer::CommandMailbox;
@@ -101,6 +93,10 @@ struct EngineStats {
   std::int64_t degraded_after_pair_ns = -1;
 };
 
+// Each pad's image stages run on the thread that owns its PadStager: the pad's capture thread
+// (the daemon: its frames come staged through set_staged_rings) or, for a pad whose frames come
+// raw through `rings`, the DSP thread itself when it takes them (tests). The rest of a sample
+// (motion, fusion, SE(3), CAN) is the DSP thread's.
 class Engine {
  public:
   // The pipeline must be configured; cameras may be null (no such sensor / tests without one).
@@ -119,6 +115,10 @@ class Engine {
   // [viewer] controls: the mailbox the viewer's POST /api/command writes (null: no controls).
   // Set before the DSP thread starts.
   void set_web_commands(CommandMailbox* box) noexcept { web_commands_ = box; }
+  // Pads whose frames arrive staged by their own thread (stager(s).stage) instead of raw through
+  // the constructor's rings (null: that pad's ring). Set before the DSP thread starts.
+  void set_staged_rings(std::array<StagedRing*, 2> rings) noexcept { staged_rings_ = rings; }
+  PadStager& stager(std::size_t s) noexcept { return stagers_[s]; }
   // One loop iteration at now_ns (CLOCK_MONOTONIC). Returns true when it did work (the caller
   // sleeps briefly when it did not).
   bool step(std::int64_t now_ns) noexcept;
@@ -141,20 +141,17 @@ class Engine {
   protocol::VelocityMode velocity_mode() const noexcept { return velocity_mode_; }
 
  private:
-  // A pad's oldest frame not yet in a cycle. Its image stages (1-6) run when it is taken from
-  // the ring, so a pair's later frame finds the earlier one's done; a frame already late then
-  // (pairing drops it) never runs them, so a pad's image state only sees frames that enter a
-  // cycle, as in DualPipeline::process.
+  // A pad's oldest frame not yet in a cycle, its image stages (1-6) done (PadStager::stage):
+  // the front of its staged ring, or the pad's inline slot.
   struct Head {
     PendingFrame pending;
-    ArrivedFrame arrived;
-    dsp::PadStages stages;
-    bool staged = false;
-    std::int64_t stage_us = 0;  // time its image stages took
+    StagedFrame* f = nullptr;
   };
   void refill_heads(std::int64_t now_ns) noexcept;
-  void run_image_stages(std::size_t s) noexcept;
+  StagedFrame* take_frame(std::size_t s) noexcept;
   void release_head(std::size_t s) noexcept;
+  void apply_pad_requests(std::size_t s, const StagedFrame& f) noexcept;
+  bool post_calibration() noexcept;
   void process(bool use_left, bool use_right, std::int64_t now_ns) noexcept;
   void emit_cycle(bool use_left, bool use_right, std::int64_t t_ns) noexcept;
   void handle_command(const protocol::CommandResult& r) noexcept;
@@ -180,10 +177,24 @@ class Engine {
   std::array<CommandRing*, 2> command_rings_;
   SharedState& shared_;
 
+  std::array<StagedRing*, 2> staged_rings_{};
+  std::array<PadStager, 2> stagers_;
   std::array<Head, 2> heads_{};
-  // A tare while a pad's head had its image stages: that frame is the last before the tare, so
-  // the pad's motion restarts once it has been through its cycle (release_head).
-  std::array<bool, 2> motion_reset_pending_{};
+  std::array<StagedFrame, 2> inline_frames_{};  // a pad staged here, from its raw ring
+  // Each pad's motion half follows its image half (PadStager): the tare and calibration epochs
+  // its motion state is at, and the calibration whose image half was posted last.
+  std::array<std::uint32_t, 2> motion_tare_epoch_{};
+  std::array<std::uint32_t, 2> motion_calibration_epoch_{};
+  std::array<std::uint32_t, 2> posted_calibration_epoch_{};
+  std::array<dsp::Calibration, 2> posted_calibration_{};
+  std::array<dsp::Calibration, 2> reload_calibration_{};  // the reload being posted
+  std::array<bool, 2> reload_posted_{};                   // its image half posted to the pad
+  bool reload_started_ = false;
+  std::array<int, 2> contact_cells_{};  // |Ω| of each pad's last frame in a cycle
+  // The viewer's grid fields and image of each pad, and |Ω| in them: a frame staged at most a
+  // frame period before the view is due (PadStager::want_view_fields).
+  std::array<viewer::ViewPad, 2> view_pads_{};
+  std::array<int, 2> view_contact_cells_{};
   std::array<SensorObservation, 2> observed_{};
   std::array<std::uint64_t, 2> pairing_drops_{};
   StateMachine machine_;

@@ -40,6 +40,8 @@ const char* to_string(PairAction a) noexcept;
 // (configured, streaming and not stale). `last_t_ns`: timestamp of the last processed sample
 // (INT64_MIN before the first) -- output samples must be strictly increasing in time.
 //  1. A head not newer than last_t_ns is dropped (late frame whose partner was already used).
+//     Its pad's thread skips the image stages of a frame already late when it takes it; one that
+//     became late during them is dropped with them done (PadStager::stage).
 //  2. Both heads within tolerance: pair.
 //  3. Both heads, further apart: the older one is processed alone (its partner was dropped).
 //  4. One head: alone at once if the other sensor is not alive, else after max_wait_ns.

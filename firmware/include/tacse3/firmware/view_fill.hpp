@@ -15,10 +15,11 @@ namespace tacse3::firmware {
 using viewer::ViewSlot;
 using viewer::ViewSnapshot;
 
-// Fills every pad field of *out from the pipeline's last result and the pads' health (bounded
-// copy, no allocation).
+// Fills the per-cycle pad scalars of *out from the pipeline's last result, the pads' |Ω| in it
+// and their health. The grid fields and image come from the pad threads (PadStager), which own
+// them; the calibration read here is the motion half, the DSP thread's.
 void fill_view_pads(const dsp::DualPipeline& pipeline, const dsp::DualResult& result,
                     const StateOutput& state, std::array<bool, 2> configured,
-                    ViewSnapshot* out) noexcept;
+                    std::array<int, 2> contact_cells, ViewSnapshot* out) noexcept;
 
 }  // namespace tacse3::firmware

@@ -1,0 +1,138 @@
+// SPDX-License-Identifier: Apache-2.0
+// tacse3 firmware: one pad's image stages, run by the thread that owns the pad's image state,
+// and the hand-off of tare, calibration and the viewer's fields between it and the DSP thread.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+
+#include "tacse3/dsp/pipeline.hpp"
+#include "tacse3/hal/camera.hpp"
+#include "tacse3/hal/camera/spsc_ring.hpp"
+#include "tacse3/viewer/view_snapshot.hpp"
+
+namespace tacse3::firmware {
+
+// A frame as the capture thread hands it on: with the moment it received it from the camera
+// (CLOCK_MONOTONIC), where the arrival latencies start (CycleLatency).
+struct ArrivedFrame {
+  hal::Frame frame;
+  std::int64_t arrival_ns = 0;
+};
+// Capture thread -> DSP thread when the DSP thread runs the stages itself (tests). 8 frames =
+// 66 ms at 120 Hz, more than the camera has buffers, so the ring never holds the camera back.
+using FrameRing = hal::SpscRing<ArrivedFrame, 8>;
+
+// A frame with its image stages (dsp stages 1-6) done, or not run because it was already late.
+// The epochs say which tare and which calibration its stages ran under (PadStager).
+struct StagedFrame {
+  ArrivedFrame arrived;
+  dsp::PadStages stages;
+  bool staged = false;
+  std::int64_t stage_us = 0;  // time its image stages took
+  std::uint32_t tare_epoch = 0;
+  std::uint32_t calibration_epoch = 0;
+};
+// A lock-free single-producer single-consumer ring whose elements are written and read in
+// place (a staged frame is 31 KB: copying it in and out would cost more than the hand-off).
+// The producer fills back() and commits it; the consumer reads front() until it pops it.
+template <typename T, std::size_t Capacity>
+class SlotRing {
+  static_assert(Capacity >= 2 && (Capacity & (Capacity - 1)) == 0, "capacity: power of two");
+
+ public:
+  // Producer: the slot to fill next, or null when the ring is full.
+  T* back() noexcept {
+    const std::size_t head = head_.load(std::memory_order_relaxed);
+    if (head - tail_.load(std::memory_order_acquire) == Capacity) return nullptr;
+    return &slots_[head & (Capacity - 1)];
+  }
+  void commit() noexcept {
+    head_.store(head_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+  }
+  // Consumer: the oldest committed slot, or null when the ring is empty.
+  T* front() noexcept {
+    const std::size_t tail = tail_.load(std::memory_order_relaxed);
+    if (tail == head_.load(std::memory_order_acquire)) return nullptr;
+    return &slots_[tail & (Capacity - 1)];
+  }
+  void pop() noexcept {
+    tail_.store(tail_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+  }
+  static constexpr std::size_t capacity() noexcept { return Capacity; }
+
+ private:
+  alignas(64) std::atomic<std::size_t> head_{0};  // written by the producer
+  alignas(64) std::atomic<std::size_t> tail_{0};  // written by the consumer
+  alignas(64) std::array<T, Capacity> slots_{};
+};
+
+// Pad thread -> DSP thread: the same depth as FrameRing.
+using StagedRing = SlotRing<StagedFrame, 8>;
+
+// Owns one pad's image state (SensorPipeline::process_image, tare_image, set_image_calibration):
+// stage() is called by one thread only, the pad's; the other members by the DSP thread. The DSP
+// thread asks, the pad thread applies before its next frame's stages and stamps that frame with
+// the epoch it applied, so the DSP thread applies the motion half (reset_motion,
+// set_motion_calibration) exactly at the first frame staged after the request: the frames
+// staged before a tare are the last of the old reference, as a tare between two frames of one
+// thread. No lock, no allocation; each request is one atomic store.
+class PadStager {
+ public:
+  PadStager(dsp::SensorPipeline& sensor, std::int64_t (*clock)() noexcept) noexcept
+      : sensor_(sensor), clock_(clock) {}
+
+  // Pad thread. Runs f's image stages into out unless f is not newer than the last sample
+  // (set_last_sample: the DSP thread drops it). A frame that becomes late while its stages run
+  // is dropped by the DSP thread with its stages done: the pad's image state has then seen a
+  // frame that entered no cycle, as when the camera delivers one that pairing drops.
+  void stage(const ArrivedFrame& f, StagedFrame& out) noexcept;
+
+  // DSP thread: the sample time of the last processed sample (frames not newer are late).
+  void set_last_sample(std::int64_t t_ns) noexcept {
+    last_t_ns_.store(t_ns, std::memory_order_release);
+  }
+  // DSP thread: re-take the reference before the next frame. Returns the tare epoch the next
+  // staged frame carries.
+  std::uint32_t request_tare() noexcept {
+    return tare_requested_.fetch_add(1, std::memory_order_release) + 1;
+  }
+  // DSP thread: the image half of cal before the next frame. Returns the calibration epoch the
+  // next staged frame carries, or 0 when not posted (ask again later): the pad thread is taking
+  // the previous request right now, or has taken it and `after_taken` is false (the DSP thread
+  // has not seen a frame of that epoch yet: its motion half still waits). A request the pad has
+  // not taken yet is replaced (a lost pad never takes one).
+  std::uint32_t request_calibration(const dsp::Calibration& cal, bool after_taken) noexcept;
+  // DSP thread: asks for the viewer's fields of the next staged frame (a view is due soon).
+  void want_view_fields() noexcept {
+    int idle = kViewIdle;
+    view_state_.compare_exchange_strong(idle, kViewWanted, std::memory_order_acq_rel);
+  }
+  // DSP thread: copies the fields asked for into *out (grid fields and image) and *contact_cells
+  // (|Ω| of that frame). False (nothing touched) when they are not there yet.
+  bool take_view_fields(viewer::ViewPad* out, int* contact_cells) noexcept;
+
+ private:
+  void apply_requests() noexcept;
+
+  enum : int { kIdle = 0, kPosted, kBusy };  // calibration mailbox: who holds calibration_
+  // view_: the pad thread writes it while kViewWanted, the DSP thread reads it while kViewFilled.
+  enum : int { kViewWanted = 0, kViewFilled, kViewIdle };
+
+  dsp::SensorPipeline& sensor_;
+  std::int64_t (*clock_)() noexcept;
+  std::atomic<std::int64_t> last_t_ns_{INT64_MIN};
+  std::atomic<std::uint32_t> tare_requested_{0};
+  std::uint32_t tare_applied_ = 0;  // pad thread
+  std::atomic<int> calibration_state_{kIdle};
+  dsp::Calibration calibration_{};  // held by whoever set calibration_state_ to kBusy
+  std::uint32_t calibration_posted_ = 0;
+  std::uint32_t calibration_applied_ = 0;  // pad thread
+  std::atomic<int> view_state_{kViewWanted};
+  viewer::ViewPad view_{};  // the grid fields and image only
+  int view_contact_cells_ = 0;
+};
+
+}  // namespace tacse3::firmware
