@@ -26,7 +26,7 @@ const void* address_of(F* f) noexcept {
 }
 
 struct Search {
-  std::span<const void* const> code;
+  std::span<const void* const> code;  // empty: every object
   std::vector<LoadedObject>* out;
 };
 
@@ -42,9 +42,10 @@ bool holds(const dl_phdr_info& info, std::uintptr_t a) noexcept {
 
 int visit(dl_phdr_info* info, std::size_t, void* data) {
   auto* s = static_cast<Search*>(data);
-  const bool wanted = std::any_of(s->code.begin(), s->code.end(), [&](const void* c) {
-    return c != nullptr && holds(*info, reinterpret_cast<std::uintptr_t>(c));
-  });
+  const bool wanted =
+      s->code.empty() || std::any_of(s->code.begin(), s->code.end(), [&](const void* c) {
+        return c != nullptr && holds(*info, reinterpret_cast<std::uintptr_t>(c));
+      });
   if (!wanted) return 0;
   const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
   LoadedObject o;
@@ -67,14 +68,17 @@ bool inside(const std::vector<LoadedObject>& objects, std::uintptr_t a) noexcept
   return false;
 }
 
-// Releases the clean file pages outside `keep`; returns the bytes of the mappings released.
+// Releases the clean pages of the loaded objects outside `keep`; returns the bytes of the
+// mappings released. Only an object's own mappings: a device's (a camera's buffers, mapped
+// read-only) has no page to read back, and touching it after a release raises SIGBUS.
 std::size_t release_clean_pages(const std::vector<LoadedObject>& keep) {
+  const std::vector<LoadedObject> all = objects_containing({});
   std::ifstream f("/proc/self/smaps");
   std::stringstream text;
   text << f.rdbuf();
   std::size_t released = 0;
   for (const Mapping& m : clean_file_mappings(text.str())) {
-    if (inside(keep, m.begin)) continue;
+    if (!inside(all, m.begin) || inside(keep, m.begin)) continue;
     if (madvise(reinterpret_cast<void*>(m.begin), m.end - m.begin, MADV_DONTNEED) == 0)
       released += m.end - m.begin;
   }

@@ -20,8 +20,9 @@ struct LoadedObject {
   std::vector<Segment> segments;
 };
 
-// The loaded objects holding any of `code` (addresses inside them), each once, in load order.
-// Addresses in no loaded object (heap, stack) select nothing.
+// The loaded objects holding any of `code` (addresses inside them), each once, in load order;
+// every loaded object if `code` is empty. Addresses in no loaded object (heap, stack) select
+// nothing.
 std::vector<LoadedObject> objects_containing(std::span<const void* const> code);
 
 // An address in each object the DSP thread runs through: the program (dsp/ and firmware/ are
@@ -51,8 +52,8 @@ struct MemoryLock {
 
 // Locks the process's memory for the real-time loop: the real-time objects in full and at once
 // (mlock), everything else (heap, stacks, other libraries) page by page as it is first touched
-// (mlockall MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT). First it releases the other objects' clean
-// file pages (clean_file_mappings, MADV_DONTNEED): the loader touched them while relocating and
+// (mlockall MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT). First it releases the other loaded objects'
+// clean pages (clean_file_mappings, MADV_DONTNEED): the loader touched them while relocating and
 // running constructors, and only those the daemon uses again come back, locked. A kernel without
 // MCL_ONFAULT (before 4.4) gets everything locked at once. Never fails hard: missing privileges
 // are in `message`.
