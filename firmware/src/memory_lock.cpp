@@ -62,10 +62,8 @@ int visit(dl_phdr_info* info, std::size_t, void* data) {
 }
 
 bool inside(const std::vector<LoadedObject>& objects, std::uintptr_t a) noexcept {
-  for (const LoadedObject& o : objects)
-    for (const LoadedObject::Segment& s : o.segments)
-      if (a >= s.begin && a - s.begin < s.bytes) return true;
-  return false;
+  return std::any_of(objects.begin(), objects.end(),
+                     [a](const LoadedObject& o) { return o.contains(a); });
 }
 
 // Releases the clean pages of the loaded objects outside `keep`; returns the bytes of the

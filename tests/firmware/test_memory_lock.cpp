@@ -27,10 +27,7 @@ std::string basename_of(const std::string& p) {
 }
 
 bool covers(const LoadedObject& o, const void* a) {
-  const auto x = reinterpret_cast<std::uintptr_t>(a);
-  for (const auto& s : o.segments)
-    if (x >= s.begin && x - s.begin < s.bytes) return true;
-  return false;
+  return o.contains(reinterpret_cast<std::uintptr_t>(a));
 }
 
 TEST(MemoryLock, TheRealTimeCodeIsInTheProgramAndFiveLibraries) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// firmware tests: the in-place staged-frame ring and a pad's hand-off of tare, calibration and
-// the viewer's fields (PadStager), against a SensorPipeline driven by hand.
+// firmware tests: a pad's hand-off of tare, calibration and the viewer's fields (PadStager),
+// against a SensorPipeline driven by hand.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -67,33 +67,6 @@ class PadStagerTest : public ::testing::Test {
 };
 
 }  // namespace
-
-TEST(SlotRing, HandsSlotsOverInPlaceInOrderUpToItsCapacity) {
-  SlotRing<int, 4> ring;
-  EXPECT_EQ(ring.front(), nullptr);
-  std::vector<int*> slots;
-  for (int i = 0; i < 4; ++i) {
-    int* slot = ring.back();
-    ASSERT_NE(slot, nullptr);
-    *slot = 10 + i;
-    slots.push_back(slot);
-    ring.commit();
-  }
-  EXPECT_EQ(ring.back(), nullptr) << "full";
-  // The consumer reads the producer's slots themselves, oldest first.
-  for (int i = 0; i < 4; ++i) {
-    const int* slot = ring.front();
-    ASSERT_NE(slot, nullptr);
-    ASSERT_EQ(slot, slots[static_cast<std::size_t>(i)]);
-    const int value = *slot;
-    EXPECT_EQ(value, 10 + i);
-    ring.pop();
-    if (i == 0) {
-      EXPECT_EQ(ring.back(), slots[0]) << "the first slot is free again";
-    }
-  }
-  EXPECT_EQ(ring.front(), nullptr);
-}
 
 TEST_F(PadStagerTest, StagesLikeTheSensorPipelineAndSkipsALateFrame) {
   for (std::size_t i = 0; i < 3; ++i) ASSERT_TRUE(stage_both(i)) << i;

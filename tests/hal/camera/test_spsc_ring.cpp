@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-// Tests for the lock-free SPSC ring used between libcamera's thread and the capture thread.
+// Tests for the lock-free SPSC ring used between libcamera's thread and the capture thread,
+// and in place between a pad's thread and the DSP thread.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <thread>
+#include <vector>
 
 #include "tacse3/hal/camera/spsc_ring.hpp"
 
@@ -22,6 +24,33 @@ TEST(SpscRing, FillsToCapacityThenRefuses) {
     EXPECT_EQ(v, i);
   }
   EXPECT_FALSE(r.pop(v));
+}
+
+TEST(SpscRing, HandsSlotsOverInPlaceInOrderUpToItsCapacity) {
+  SpscRing<int, 4> ring;
+  EXPECT_EQ(ring.front(), nullptr);
+  std::vector<int*> slots;
+  for (int i = 0; i < 4; ++i) {
+    int* slot = ring.back();
+    ASSERT_NE(slot, nullptr);
+    *slot = 10 + i;
+    slots.push_back(slot);
+    ring.commit();
+  }
+  EXPECT_EQ(ring.back(), nullptr) << "full";
+  // The consumer reads the producer's slots themselves, oldest first.
+  for (int i = 0; i < 4; ++i) {
+    const int* slot = ring.front();
+    ASSERT_NE(slot, nullptr);
+    ASSERT_EQ(slot, slots[static_cast<std::size_t>(i)]);
+    const int value = *slot;
+    EXPECT_EQ(value, 10 + i);
+    ring.pop();
+    if (i == 0) {
+      EXPECT_EQ(ring.back(), slots[0]) << "the first slot is free again";
+    }
+  }
+  EXPECT_EQ(ring.front(), nullptr);
 }
 
 TEST(SpscRing, WrapsManyTimes) {

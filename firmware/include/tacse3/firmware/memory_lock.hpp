@@ -18,6 +18,11 @@ struct LoadedObject {
   };
   std::string path;  // as the dynamic loader names it ("" for the program itself)
   std::vector<Segment> segments;
+  bool contains(std::uintptr_t a) const noexcept {
+    for (const Segment& s : segments)
+      if (a >= s.begin && a - s.begin < s.bytes) return true;
+    return false;
+  }
 };
 
 // The loaded objects holding any of `code` (addresses inside them), each once, in load order;

@@ -35,42 +35,9 @@ struct StagedFrame {
   std::uint32_t tare_epoch = 0;
   std::uint32_t calibration_epoch = 0;
 };
-// A lock-free single-producer single-consumer ring whose elements are written and read in
-// place (a staged frame is 31 KB: copying it in and out would cost more than the hand-off).
-// The producer fills back() and commits it; the consumer reads front() until it pops it.
-template <typename T, std::size_t Capacity>
-class SlotRing {
-  static_assert(Capacity >= 2 && (Capacity & (Capacity - 1)) == 0, "capacity: power of two");
-
- public:
-  // Producer: the slot to fill next, or null when the ring is full.
-  T* back() noexcept {
-    const std::size_t head = head_.load(std::memory_order_relaxed);
-    if (head - tail_.load(std::memory_order_acquire) == Capacity) return nullptr;
-    return &slots_[head & (Capacity - 1)];
-  }
-  void commit() noexcept {
-    head_.store(head_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
-  }
-  // Consumer: the oldest committed slot, or null when the ring is empty.
-  T* front() noexcept {
-    const std::size_t tail = tail_.load(std::memory_order_relaxed);
-    if (tail == head_.load(std::memory_order_acquire)) return nullptr;
-    return &slots_[tail & (Capacity - 1)];
-  }
-  void pop() noexcept {
-    tail_.store(tail_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
-  }
-  static constexpr std::size_t capacity() noexcept { return Capacity; }
-
- private:
-  alignas(64) std::atomic<std::size_t> head_{0};  // written by the producer
-  alignas(64) std::atomic<std::size_t> tail_{0};  // written by the consumer
-  alignas(64) std::array<T, Capacity> slots_{};
-};
-
-// Pad thread -> DSP thread: the same depth as FrameRing.
-using StagedRing = SlotRing<StagedFrame, 8>;
+// Pad thread -> DSP thread, written and read in place (hal::SpscRing's back() and front()): a
+// staged frame is 31 KB, and copying it in and out would cost more than the hand-off.
+using StagedRing = hal::SpscRing<StagedFrame, 8>;
 
 // Owns one pad's image state (SensorPipeline::process_image, tare_image, set_image_calibration):
 // stage() is called by one thread only, the pad's; the other members by the DSP thread. The DSP
