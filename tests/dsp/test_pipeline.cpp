@@ -255,6 +255,13 @@ INSTANTIATE_TEST_SUITE_P(Scenes, FixedVsReference, ::testing::ValuesIn(agreement
 // flow windows and a σ = 8 px smoothing, and Ω reaches a little beyond the sticking patch where
 // the gel has already relaxed, so the magnitudes come out low; the per-axis calibration scales
 // absorb that. What must hold exactly is the direction, the sign and the separation of the axes.
+// docs/performance.md (Memory) quotes this size: both pads' state, no heap. The bound is the
+// budget that statement relies on.
+TEST(DualPipeline, StaticFootprint) {
+  std::printf("  sizeof(DualPipeline) = %zu bytes\n", sizeof(DualPipeline));
+  EXPECT_LE(sizeof(DualPipeline), std::size_t{4480} * 1024);
+}
+
 TEST(PipelineTruth, RotationAboutNormalAxis) {
   const Rendered& r = rotation_about_z();
   const RunResult fx = run_fixed(r, dual_config(r.scene, FusionMethod::kJoint),
