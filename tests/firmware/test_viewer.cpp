@@ -351,6 +351,16 @@ EngineTiming summary_timing(const std::string& out) {
   return t;
 }
 
+// The "viewer: N snapshots served" count of the daemon's summary; 0 when missing.
+std::size_t snapshots_served(const std::string& out) {
+  unsigned long n = 0;
+  for (std::size_t from = 0, hit; (hit = out.find("viewer: ", from)) != std::string::npos;
+       from = hit + 1) {
+    if (std::sscanf(out.c_str() + hit, "viewer: %lu snapshots served", &n) == 1) return n;
+  }
+  return 0;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];  // odd sizes only here
@@ -470,8 +480,14 @@ TEST_F(ViewerTest, EngineTimingHoldsWithFourClientsOneNeverReading) {
       std::printf("pair %d, %d clients: latency p50 %.0f us p99 %.0f us, dsp p50 %.0f us\n", pair,
                   4 * clients, t.latency_p50_us, t.latency_p99_us, t.dsp_p50_us);
     }
-    // ~3.5 s of stream at 20 Hz each: the readers were there for the whole window.
-    for (const std::size_t n : events[1]) EXPECT_GE(n, 20u) << "a reader's events\n" << d[1].out;
+    // Each reader saw most of what the server rendered: a reader held up by the mute client would
+    // see a few events at most. Against what was rendered, not a nominal 20 Hz, because on a
+    // loaded machine the nice'd sampler renders fewer; half, as the readers connect only once
+    // /api/state answers.
+    const std::size_t rendered = snapshots_served(d[1].out);
+    ASSERT_GT(rendered, 0u) << "no snapshot rendered\n" << d[1].out;
+    for (const std::size_t n : events[1])
+      EXPECT_GE(2 * n, rendered) << "a reader's events of " << rendered << "\n" << d[1].out;
     EXPECT_NE(d[1].out.find("0 streams refused"), std::string::npos) << d[1].out;
   }
   const double slack_us = 1000.0 * kTimeScale;
