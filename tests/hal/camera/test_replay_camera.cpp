@@ -118,9 +118,12 @@ TEST(ReplayCamera, FastModeDeliversEveryFrameThenEnds) {
       EXPECT_EQ(d.decodes, static_cast<std::uint64_t>(kFrames));
       EXPECT_GT(d.arena_allocations, 0u);
       EXPECT_EQ(d.heap_fallbacks, 0u);
-      std::printf("channels %d: %llu arena allocations for %d decodes, peak %zu bytes\n", channels,
-                  static_cast<unsigned long long>(d.arena_allocations), kFrames,
-                  d.arena_peak_bytes);
+      // Sized by open()'s trial decode: twice its peak, at least 64 KiB, in whole pages.
+      EXPECT_GE(d.arena_bytes, d.arena_peak_bytes);
+      EXPECT_LE(d.arena_bytes, std::max<std::size_t>(2 * d.arena_peak_bytes, 64 << 10) + 4096);
+      std::printf("channels %d: %llu arena allocations for %d decodes, peak %zu of %zu bytes\n",
+                  channels, static_cast<unsigned long long>(d.arena_allocations), kFrames,
+                  d.arena_peak_bytes, d.arena_bytes);
       cam->stop();
     }
     fs::remove_all(dir);

@@ -31,9 +31,12 @@ namespace rec = tacse3::recording;
 
 constexpr int kMaxBuffers = 16;
 constexpr std::int64_t kPollNs = 4'000'000;
-// libspng's context, zlib's inflate state and window and two row buffers: about 60 KiB for a
-// 320-pixel RGB row; the arena leaves room for far larger frames.
-constexpr std::size_t kArenaBytes = 1u << 20;
+// libspng's context, zlib's inflate state and window and two row buffers: about 46 KiB for a
+// 320x240 RGB frame. open() decodes the first frame in a trial arena of this size and keeps an
+// arena twice what that decode used (libspng's allocations follow the image's size and format,
+// not its content); a decode that needs more falls back to the heap and is counted.
+constexpr std::size_t kTrialArenaBytes = 1u << 20;
+constexpr std::size_t kMinArenaBytes = 64u << 10;
 
 void bump(std::atomic<std::uint64_t>& c, std::uint64_t n = 1) noexcept {
   c.fetch_add(n, std::memory_order_relaxed);
@@ -44,6 +47,7 @@ void bump(std::atomic<std::uint64_t>& c, std::uint64_t n = 1) noexcept {
 // own frames). Blocks carry their size in a 16-byte header so realloc can copy.
 struct Arena {
   std::unique_ptr<std::uint8_t[]> mem;
+  std::size_t size = 0;
   std::size_t used = 0;
   std::size_t peak = 0;
   std::uint64_t allocations = 0;
@@ -51,7 +55,7 @@ struct Arena {
 
   bool owns(const void* p) const noexcept {
     const auto* b = static_cast<const std::uint8_t*>(p);
-    return b >= mem.get() && b < mem.get() + kArenaBytes;
+    return b >= mem.get() && b < mem.get() + size;
   }
 };
 
@@ -61,7 +65,7 @@ constexpr std::size_t kHeader = 16;
 void* arena_malloc(std::size_t size) noexcept {
   Arena* a = t_arena;
   const std::size_t need = kHeader + ((size + 15) & ~static_cast<std::size_t>(15));
-  if (a != nullptr && a->used + need <= kArenaBytes) {
+  if (a != nullptr && a->used + need <= a->size) {
     std::uint8_t* p = a->mem.get() + a->used;
     std::memcpy(p, &size, sizeof(size));
     a->used += need;
@@ -120,6 +124,7 @@ class ReplayCamera final : public Camera {
     s.arena_allocations = arena_allocations_.load(std::memory_order_relaxed);
     s.heap_fallbacks = heap_fallbacks_.load(std::memory_order_relaxed);
     s.arena_peak_bytes = arena_peak_.load(std::memory_order_relaxed);
+    s.arena_bytes = arena_.size;
     return s;
   }
 
@@ -127,6 +132,8 @@ class ReplayCamera final : public Camera {
   const char* side() const noexcept { return cfg_.right ? "right" : "left"; }
   // Reads and decodes frame `index` into buffer `slot`.
   CameraStatus decode(std::size_t index, int slot) noexcept;
+  // Sizes the decoder's arena by a trial decode of the first frame (kTrialArenaBytes).
+  void size_arena();
   void take_returned() noexcept {
     std::uint32_t s = 0;
     while (returned_.pop(s)) {
@@ -236,7 +243,6 @@ CameraStatus ReplayCamera::open() {
   // Room for a file that grows a little after open() (a re-encoded frame); larger is an error.
   file_buf_bytes_ = largest + largest / 4 + 4096;
   file_buf_.reset(new std::uint8_t[file_buf_bytes_]());
-  arena_.mem.reset(new std::uint8_t[kArenaBytes]());
   nominal_period_ns_ = static_cast<std::int64_t>(1e9 / in.fps);
 
   info_.format = channels_ == 3 ? dsp::PixelFormat::kRgb888 : dsp::PixelFormat::kGrey;
@@ -252,6 +258,7 @@ CameraStatus ReplayCamera::open() {
   info_.timestamp_source = TimestampSource::kSimulated;
   held_.fill(false);
   outstanding_ = 0;
+  size_arena();  // decode() checks the frame against info_
   state_.store(LinkState::kOpen, std::memory_order_release);
   return CameraStatus::success();
 }
@@ -279,6 +286,25 @@ CameraStats ReplayCamera::stats() const {
   s.timeouts = n_.timeouts.load(std::memory_order_relaxed);
   s.disconnects = n_.disconnects.load(std::memory_order_relaxed);
   return s;
+}
+
+void ReplayCamera::size_arena() {
+  // The trial arena is left uninitialised: only the pages the decode touches become resident.
+  arena_ = Arena{};
+  arena_.mem = std::make_unique_for_overwrite<std::uint8_t[]>(kTrialArenaBytes);
+  arena_.size = kTrialArenaBytes;
+  // A first frame that does not decode keeps the trial arena; next_frame() reports the frame.
+  std::size_t size = kTrialArenaBytes;
+  if (decode(0, 0).ok()) {
+    size = (std::max(2 * arena_.peak, kMinArenaBytes) + 4095) & ~static_cast<std::size_t>(4095);
+  }
+  arena_ = Arena{};
+  arena_.mem.reset(new std::uint8_t[size]());
+  arena_.size = size;
+  decodes_.store(0, std::memory_order_relaxed);
+  arena_allocations_.store(0, std::memory_order_relaxed);
+  heap_fallbacks_.store(0, std::memory_order_relaxed);
+  arena_peak_.store(0, std::memory_order_relaxed);
 }
 
 CameraStatus ReplayCamera::decode(std::size_t index, int slot) noexcept {

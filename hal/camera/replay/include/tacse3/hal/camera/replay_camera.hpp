@@ -26,6 +26,7 @@ struct ReplayDecodeStats {
   std::uint64_t arena_allocations = 0;  // libspng/zlib allocations served by the decoder arena
   std::uint64_t heap_fallbacks = 0;     // allocations the arena could not hold (went to malloc)
   std::size_t arena_peak_bytes = 0;     // most arena bytes one decode used
+  std::size_t arena_bytes = 0;          // the arena's size, set by open()'s trial decode
 };
 
 // A Camera replaying one sensor of a recording. open() validates the whole recording
