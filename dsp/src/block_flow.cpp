@@ -458,10 +458,12 @@ Status BlockFlow::configure(const BlockFlowConfig& config) noexcept {
   th_.keyframe_min_valid_q16 =
       static_cast<std::int64_t>(config.keyframe_min_valid_fraction * 65536.0 + 0.5);
   has_reference_ = false;
+  deferred_pending_ = false;  // a switch decided under the old config is dropped with the reference
   return Status::kOk;
 }
 
 void BlockFlow::tare(const WorkImage& frame) noexcept {
+  run_deferred();  // the state a tare leaves is then that of every earlier frame's work done
   // The tare frame keeps its own pyramid slot and its own level-0 window models for the whole
   // session (re-anchoring, see re_anchor()).
   build_pyramid(frame, config_.pyramid_levels, pyramid_[kTareSlot]);
@@ -510,6 +512,7 @@ void BlockFlow::build_coarse() noexcept {
 
 void BlockFlow::complete_keyframe() noexcept {
   if (!has_reference_) return;
+  run_deferred();
   if (level0_pending_) build_level0();
   build_coarse();
 }
@@ -658,7 +661,7 @@ void BlockFlow::build_models(int level) noexcept {
       m.inv_c = static_cast<std::int32_t>(inv_c);
       m.shift = static_cast<std::int8_t>(shift);
       if (level == 0) {
-        if (lost_.v[static_cast<std::size_t>(index)]) continue;  // see maybe_switch_keyframe()
+        if (lost_.v[static_cast<std::size_t>(index)]) continue;  // see switch_keyframe()
         measurement_moments(tpl, m);
       }
       m.valid = 1;
@@ -1009,8 +1012,8 @@ void BlockFlow::write_output(VectorField& displacement, GridMask& valid) noexcep
 // keyframe, and the frame is healthy, the current frame becomes the keyframe. The material
 // points' current displacements become the new keyframe displacements, so the total relative
 // to the tare frame carries over (invalid points carry their held value).
-void BlockFlow::maybe_switch_keyframe() noexcept {
-  if (th_.keyframe_switch_sq_q32 == 0) return;
+bool BlockFlow::keyframe_switch_due() const noexcept {
+  if (th_.keyframe_switch_sq_q32 == 0) return false;
   std::int64_t max_sq = 0;
   for (int i = 0; i < kGridCount; ++i) {
     if (!frame_valid_.v[static_cast<std::size_t>(i)]) continue;
@@ -1018,10 +1021,13 @@ void BlockFlow::maybe_switch_keyframe() noexcept {
     const std::int64_t y = window_flow_.y.v[static_cast<std::size_t>(i)];
     max_sq = std::max(max_sq, x * x + y * y);  // |x|, |y| <= 2^30: sum < 2^61
   }
-  if (max_sq <= th_.keyframe_switch_sq_q32) return;
-  if (std::int64_t{valid_count_} * 65536 < th_.keyframe_min_valid_q16 * keyframe_valid_count_) {
-    return;
-  }
+  if (max_sq <= th_.keyframe_switch_sq_q32) return false;
+  return std::int64_t{valid_count_} * 65536 >= th_.keyframe_min_valid_q16 * keyframe_valid_count_;
+}
+
+// The switch itself, in run_deferred() after the frame that decided it (keyframe_switch_due()
+// in track()): it reads only that frame's state, which nothing changes in between.
+void BlockFlow::switch_keyframe() noexcept {
   // Points not tracked in this frame only have a stale (held) displacement; a window placed
   // there would follow the wrong material from now on. Their keyframe displacement is instead
   // re-estimated from the tracked neighbours (local affine fit); points without enough tracked
@@ -1049,9 +1055,18 @@ void BlockFlow::maybe_switch_keyframe() noexcept {
   key_level0_is_tare_ = false;
   level0_pending_ = true;
   coarse_pending_ = config_.pyramid_levels > 1;
-  ++keyframe_switches_;
-  frames_since_keyframe_ = 0;
-  last_frame_was_keyframe_ = true;
+}
+
+void BlockFlow::run_deferred() noexcept {
+  if (!deferred_pending_) return;
+  deferred_pending_ = false;
+  if (last_frame_was_keyframe_) {
+    switch_keyframe();
+    build_level0();  // the next track() matches against it
+  } else if (frames_since_keyframe_ >= 2) {
+    // The coarse models of a keyframe no coarse pass has needed yet, in its second frame.
+    build_coarse();
+  }
 }
 
 // Re-anchoring at a keyframe switch. The chained displacement D_key + flow carries the
@@ -1163,7 +1178,8 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
   // failed windows) only run when enough windows failed, e.g. after a jump larger than the
   // convergence range of level 0 (~1-2 px) or on the first frames after a tare; at steady state
   // the warm start is within a fraction of a pixel and level 0 alone converges.
-  // The keyframe's window models are built in bounded pieces (see maybe_switch_keyframe()).
+  // The keyframe's window models are built in bounded pieces (see complete_keyframe()).
+  run_deferred();
   if (level0_pending_) build_level0();
   ImagePyramid& cur = pyramid_[static_cast<std::size_t>(cur_index_)];
   build_pyramid(frame, 1, cur);
@@ -1178,11 +1194,12 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
   }
   write_output(displacement, valid);
   ++frames_since_keyframe_;
-  last_frame_was_keyframe_ = false;
-  maybe_switch_keyframe();
-  // The coarse models of a keyframe no coarse pass has needed yet, in its second frame (the first
-  // built level 0), unless this frame replaced it.
-  if (!last_frame_was_keyframe_ && frames_since_keyframe_ >= 2) build_coarse();
+  last_frame_was_keyframe_ = keyframe_switch_due();
+  if (last_frame_was_keyframe_) {
+    ++keyframe_switches_;
+    frames_since_keyframe_ = 0;
+  }
+  deferred_pending_ = true;
 }
 
 }  // namespace tacse3::dsp

@@ -111,6 +111,7 @@ void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& 
   PadStages& stages = scratch_;
   process_image(frame, stages);
   finish_motion(stages, dt_s, out);
+  run_deferred();
 }
 
 void SensorPipeline::process_image(const FrameView& frame, PadStages& stages) noexcept {
@@ -252,6 +253,7 @@ void DualPipeline::process(const FrameView* left, const FrameView* right, std::i
   if (right != nullptr) process_pad(SensorSlot::kRight, *right, stages_[1]);
   finish(left != nullptr ? &stages_[0] : nullptr, right != nullptr ? &stages_[1] : nullptr, t_ns,
          out);
+  for (SensorPipeline& p : sensors_) p.run_deferred();
 }
 
 void DualPipeline::process_pad(SensorSlot s, const FrameView& frame, PadStages& out) noexcept {

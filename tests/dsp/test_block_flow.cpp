@@ -244,21 +244,24 @@ TEST(BlockFlow, GrowingDeformationStaysTrackedAcrossKeyframes) {
 }
 
 // A keyframe's window models are built in pieces over the frames after the switch (tare: the
-// coarse levels later; switch: level 0 in the next frame, the coarse levels after). A second
-// flow that completes every keyframe at once (complete_keyframe() after each frame) must report
-// the same displacements bit for bit, and end with the same models, with the coarse pass on
-// demand and on every frame.
+// coarse levels later; switch: level 0 in its deferred work, the coarse levels after), and the
+// switch's own work is deferred. Three flows must report the same displacements bit for bit and
+// end with the same models, with the coarse pass on demand and on every frame: one that leaves
+// the deferred work to the next track(), one that runs it after each frame (run_deferred(), as
+// the daemon's pad threads do), and one that completes every keyframe at once.
 TEST(BlockFlow, KeyframeModelsBuiltInPiecesEqualAOneShotBuild) {
   for (const int trigger : {BlockFlowConfig{}.coarse_trigger, 0}) {
     BlockFlowConfig cfg;
     cfg.coarse_trigger = trigger;
     auto pieces = make_flow(cfg);
     auto one_shot = make_flow(cfg);
+    auto deferred = make_flow(cfg);
     pieces->tare(undeformed());
     one_shot->tare(undeformed());
+    deferred->tare(undeformed());
     one_shot->complete_keyframe();
-    VectorField d1, d2;
-    GridMask v1, v2;
+    VectorField d1, d2, d3;
+    GridMask v1, v2, v3;
     constexpr int kFrames = 24;
     for (int k = 1; k <= kFrames; ++k) {
       const WorkImage img =
@@ -266,9 +269,20 @@ TEST(BlockFlow, KeyframeModelsBuiltInPiecesEqualAOneShotBuild) {
       pieces->track(img, d1, v1);
       one_shot->track(img, d2, v2);
       one_shot->complete_keyframe();
+      deferred->track(img, d3, v3);
+      ASSERT_TRUE(deferred->deferred_pending());
+      ASSERT_EQ(deferred->last_frame_was_keyframe(), pieces->last_frame_was_keyframe());
+      deferred->run_deferred();
+      ASSERT_FALSE(deferred->deferred_pending());
       ASSERT_EQ(d1.x.v, d2.x.v) << "frame " << k << " trigger " << trigger;
       ASSERT_EQ(d1.y.v, d2.y.v) << "frame " << k;
       ASSERT_EQ(v1.v, v2.v) << "frame " << k;
+      ASSERT_EQ(d1.x.v, d3.x.v) << "frame " << k;
+      ASSERT_EQ(d1.y.v, d3.y.v) << "frame " << k;
+      ASSERT_EQ(v1.v, v3.v) << "frame " << k;
+      // After its deferred work, the switch's outcome is the one-shot flow's.
+      ASSERT_EQ(deferred->reanchored().v, one_shot->reanchored().v) << "frame " << k;
+      ASSERT_EQ(deferred->lost().v, one_shot->lost().v) << "frame " << k;
     }
     ASSERT_GE(pieces->keyframe_switches(), 3u);
     ASSERT_EQ(pieces->keyframe_switches(), one_shot->keyframe_switches());

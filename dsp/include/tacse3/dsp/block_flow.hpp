@@ -141,7 +141,15 @@ class BlockFlow {
   // inside the image, well-conditioned, converged, small residual, consistent with its
   // neighbours). Invalid points hold their previous displacement. The first call without a
   // reference is an implicit tare (all zeros; valid = the points trackable in that frame).
+  // A keyframe switch is decided here (last_frame_was_keyframe()), but its work, which only
+  // the next frame needs, is left to run_deferred(); track() and tare() run it first if the
+  // caller has not, so no result depends on when it runs.
   void track(const WorkImage& frame, VectorField& displacement, GridMask& valid) noexcept;
+  // The last track()'s deferred work: a keyframe switch (neighbour fit, re-anchoring) and the
+  // new keyframe's level-0 models, or a pending coarse-level build. For a caller with spare
+  // time once the frame's result is handed on; a no-op when nothing is pending.
+  void run_deferred() noexcept;
+  bool deferred_pending() const noexcept { return deferred_pending_; }
 
   bool has_reference() const noexcept { return has_reference_; }
   std::uint32_t keyframe_switches() const noexcept { return keyframe_switches_; }  // since tare
@@ -161,9 +169,9 @@ class BlockFlow {
   const VectorField& flow_from_keyframe() const noexcept { return window_flow_; }
 
   // A keyframe's window models are built in bounded pieces: at a tare level 0 at once and the
-  // coarse levels within two frames; at a switch level 0 at the start of the next track() and
-  // the coarse levels within the frame after (earlier when a coarse pass needs them). This
-  // builds whatever is still pending now (the results are the same).
+  // coarse levels within two frames; at a switch level 0 in the switch's deferred work and the
+  // coarse levels in the next frame's (earlier when a coarse pass needs them). This runs the
+  // deferred work and builds whatever is still pending now (the results are the same).
   void complete_keyframe() noexcept;
 
   // Stage access for tests and tools (call complete_keyframe() first).
@@ -225,7 +233,8 @@ class BlockFlow {
                             int iterations) const noexcept;
   void coarse_to_fine() noexcept;
   void write_output(VectorField& displacement, GridMask& valid) noexcept;
-  void maybe_switch_keyframe() noexcept;
+  bool keyframe_switch_due() const noexcept;
+  void switch_keyframe() noexcept;
   void re_anchor() noexcept;
   void upsample_correction(int level) noexcept;
   int track_fine(bool retry) noexcept;
@@ -239,6 +248,7 @@ class BlockFlow {
   std::uint32_t keyframe_switches_ = 0;
   std::uint32_t frames_since_keyframe_ = 0;
   bool last_frame_was_keyframe_ = false;
+  bool deferred_pending_ = false;    // the last track()'s run_deferred() has not run yet
   bool coarse_built_ = false;        // coarse pyramid levels of the current frame exist
   bool key_coarse_pyramid_ = false;  // coarse pyramid levels of the keyframe exist
   bool key_level0_is_tare_ = false;  // level_models(0) is the tare frame's set

@@ -97,7 +97,7 @@ class SensorPipeline {
 
   // Processes one frame taken dt_s after the previous one (dt_s in (0, 1]; the first frame after
   // configure/tare ignores it). A malformed frame returns its error in out.status and changes
-  // nothing. Never NaN, never throws.
+  // nothing. Never NaN, never throws. Includes run_deferred().
   void process(const FrameView& frame, double dt_s, SensorResult& out) noexcept;
 
   // process() in two calls: stages 1-6 (the image work, no time step; they advance the block
@@ -106,6 +106,10 @@ class SensorPipeline {
   // another thread than process_image, one frame behind it (PadStages holds what it reads).
   void process_image(const FrameView& frame, PadStages& out) noexcept;
   void finish_motion(const PadStages& stages, double dt_s, SensorResult& out) noexcept;
+  // The image work process_image leaves for later, which only the next frame needs (a keyframe
+  // switch, BlockFlow::run_deferred): for the thread that owns the image state, once the frame's
+  // stages are handed on. The next process_image or tare_image runs it if this is not called.
+  void run_deferred() noexcept { flow_.run_deferred(); }
   // tare() in the same two halves: the image half (reference, warm start, hysteresis) and the
   // motion half. tare() = both.
   void tare_image() noexcept;
@@ -203,7 +207,7 @@ class DualPipeline {
   // process() in parts: process_pad runs one sensor's stages 1-6 as soon as its frame is there
   // (possibly on its own thread: it touches only that sensor's image state); finish runs
   // stages 7-8 of the pads present (null: no frame this cycle), fusion and SE(3) at the pair's
-  // sample time t_ns. process() is exactly these calls.
+  // sample time t_ns. process() is exactly these calls, then each sensor's run_deferred().
   void process_pad(SensorSlot s, const FrameView& frame, PadStages& out) noexcept;
   void finish(const PadStages* left, const PadStages* right, std::int64_t t_ns,
               DualResult& out) noexcept;
