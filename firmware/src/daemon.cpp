@@ -542,6 +542,7 @@ void Daemon::capture_loop(std::size_t s) {
         ring.commit();
         sh.frames.fetch_add(1, std::memory_order_relaxed);
         doorbell_.ring();
+        stager.run_deferred();
       }
       sh.camera_drops.store(cam.stats().drops + overflow, std::memory_order_relaxed);
       continue;

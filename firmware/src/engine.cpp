@@ -423,6 +423,10 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   if (emit) emit_cycle(use_left, use_right, t_ns);
   if (use_left) release_head(0);
   if (use_right) release_head(1);
+  // Frames staged here (no pad threads): their deferred image work, after the cycle is sent.
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (staged_rings_[s] == nullptr) stagers_[s].run_deferred();
+  }
 }
 
 // Encodes and sends the cycle of the sample just processed (heads still held: their arrival

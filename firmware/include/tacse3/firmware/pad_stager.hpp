@@ -56,6 +56,9 @@ class PadStager {
   // is dropped by the DSP thread with its stages done: the pad's image state has then seen a
   // frame that entered no cycle, as when the camera delivers one that pairing drops.
   void stage(const ArrivedFrame& f, StagedFrame& out) noexcept;
+  // Pad thread, once the staged frame is handed on: the image work only the next frame needs (a
+  // keyframe switch, dsp::SensorPipeline::run_deferred), off the cycle's latency.
+  void run_deferred() noexcept { sensor_.run_deferred(); }
 
   // DSP thread: the sample time of the last processed sample (frames not newer are late).
   void set_last_sample(std::int64_t t_ns) noexcept {
