@@ -362,14 +362,23 @@ TEST_F(ViewServerTest, StreamsEverySnapshotAndRefusesAFifthClient) {
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // all four are streaming
   EXPECT_EQ(status_of(exchange(port(), get("/api/stream"))), 503);
   EXPECT_EQ(server_->stats().streams_refused, 1u);
-  for (std::uint64_t c = 2; c <= 4; ++c) publish(c);
-  // The first stream got the snapshot it found and each one published after, in order.
+  // The first stream got the snapshot it found and each one published after, in order. A
+  // stream sends the latest snapshot (a slow client skips, never queues), so each is published
+  // once the stream has sent the one before.
   std::string got;
   char buf[4096];
-  for (int i = 0; i < 50 && got.find("id: 4\n") == std::string::npos; ++i) {
-    const ssize_t n = recv(streams[0], buf, sizeof(buf), 0);
-    if (n <= 0) break;
-    got.append(buf, static_cast<size_t>(n));
+  const auto read_until = [&](std::uint64_t c) {
+    const std::string id = "id: " + std::to_string(c) + "\n";
+    for (int i = 0; i < 50 && got.find(id) == std::string::npos; ++i) {
+      const ssize_t n = recv(streams[0], buf, sizeof(buf), 0);
+      if (n <= 0) break;
+      got.append(buf, static_cast<size_t>(n));
+    }
+  };
+  read_until(1);
+  for (std::uint64_t c = 2; c <= 4; ++c) {
+    publish(c);
+    read_until(c);
   }
   EXPECT_NE(got.find("Content-Type: text/event-stream"), std::string::npos) << got;
   std::size_t at = 0;
