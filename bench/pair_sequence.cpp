@@ -122,6 +122,8 @@ PairTimes run_pair_sequence(const PairSequence& seq) {
   t.deferred_us.reserve(seq.pairs.size());
   t.events.reserve(seq.pairs.size());
   std::int64_t t_ns = 0;
+  bool tare_taken = false;  // this pair's stages took a tare request (firmware::PadStager)
+  bool tared = false;       // the previous pair became the reference: its successor restarts
   for (const PairFrames& pair : seq.pairs) {
     std::array<dsp::FrameView, 2> v{};
     for (std::size_t k = 0; k < 2; ++k) {
@@ -129,9 +131,19 @@ PairTimes run_pair_sequence(const PairSequence& seq) {
         v[k] = tools::frame_view(pair.pad[k].data(), dsp::kSensorWidth, dsp::kSensorHeight, 1);
       }
     }
-    // DualPipeline::process() in its parts, as the daemon runs them.
+    // DualPipeline::process() in its parts, as the daemon runs them. A tare: the pair's filters
+    // and pose restart at once, the pads take it with this pair's stages and make these frames
+    // the reference in their deferred work, and their motion restarts with the next pair.
     const double start = thread_cpu_us();
-    if (pair.events & kTare) p->tare();
+    if (pair.events & kTare) {
+      p->restart_filters();
+      p->reset_pose();
+      tare_taken = true;
+    }
+    if (tared) {
+      for (std::size_t k = 0; k < 2; ++k)
+        p->sensor_mut(static_cast<dsp::SensorSlot>(k)).reset_motion();
+    }
     std::array<const dsp::PadStages*, 2> staged{};
     for (std::size_t k = 0; k < 2; ++k) {
       if (pair.pad[k].empty()) continue;
@@ -140,12 +152,17 @@ PairTimes run_pair_sequence(const PairSequence& seq) {
     }
     p->finish(staged[0], staged[1], t_ns, out);
     const double result = thread_cpu_us();
-    for (std::size_t k = 0; k < 2; ++k)
-      p->sensor_mut(static_cast<dsp::SensorSlot>(k)).run_deferred();
+    for (std::size_t k = 0; k < 2; ++k) {
+      dsp::SensorPipeline& sp = p->sensor_mut(static_cast<dsp::SensorSlot>(k));
+      sp.run_deferred();
+      if (tare_taken) sp.tare_image();
+    }
     t.deferred_us.push_back(thread_cpu_us() - result);
     t.us.push_back(result - start);
     benchmark::DoNotOptimize(out.twist.data());
-    unsigned events = pair.events;
+    unsigned events = pair.events | (tared ? kTare : 0u);
+    tared = tare_taken;
+    tare_taken = false;
     if (out.sensors[0].keyframe_switched || out.sensors[1].keyframe_switched) {
       events |= kKeyframeSwitch;
     }

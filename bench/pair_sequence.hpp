@@ -17,7 +17,7 @@ enum PairEvent : unsigned {
   kKeyframeSwitch = 1u << 0,  // either pad's block flow took a new keyframe
   kOnset = 1u << 1,           // either pad's true contact began
   kRelease = 1u << 2,         // either pad's true contact ended
-  kTare = 1u << 3,            // the pipeline was tared just before the pair
+  kTare = 1u << 3,            // a tare was requested just before the pair, or it is the next
   kLostPad = 1u << 4,         // one pad's frame is missing, or is back after missing
 };
 inline constexpr int kPairEventCount = 5;

@@ -108,6 +108,7 @@ StagedFrame* Engine::take_frame(std::size_t s) noexcept {
   ArrivedFrame a;
   if (rings_[s] == nullptr || !rings_[s]->pop(a)) return nullptr;
   stagers_[s].stage(a, inline_frames_[s]);
+  stagers_[s].run_deferred();  // as a pad's thread does once the frame is handed on
   return &inline_frames_[s];
 }
 
@@ -214,8 +215,9 @@ void Engine::apply_pending_calibration() noexcept {
 // pose as relative to the last pose reset or tare, and the next cycle carries PoseReset = 1 so a
 // controller knows the pose jumped (from the CAN command and from the tare button alike).
 void Engine::tare_and_reset_pose() noexcept {
-  // DualPipeline::tare() in parts: each pad re-takes its reference from its last staged frame
-  // before staging the next, whose cycle restarts the pad's motion (apply_pad_requests).
+  // DualPipeline::tare() in parts: each pad's next frame to be staged becomes its reference
+  // once handed on, and the cycle of the frame after restarts the pad's motion
+  // (apply_pad_requests).
   for (PadStager& p : stagers_) (void)p.request_tare();
   pipeline_.restart_filters();
   pipeline_.reset_pose();
@@ -423,10 +425,6 @@ void Engine::process(bool use_left, bool use_right, std::int64_t now_ns) noexcep
   if (emit) emit_cycle(use_left, use_right, t_ns);
   if (use_left) release_head(0);
   if (use_right) release_head(1);
-  // Frames staged here (no pad threads): their deferred image work, after the cycle is sent.
-  for (std::size_t s = 0; s < 2; ++s) {
-    if (staged_rings_[s] == nullptr) stagers_[s].run_deferred();
-  }
 }
 
 // Encodes and sends the cycle of the sample just processed (heads still held: their arrival

@@ -9,7 +9,8 @@ void PadStager::stage(const ArrivedFrame& f, StagedFrame& out) noexcept {
   out.staged = false;
   out.stage_us = 0;
   if (f.frame.timestamp_ns > last_t_ns_.load(std::memory_order_acquire)) {
-    apply_requests();
+    apply_calibration();
+    tare_taken_ = tare_requested_.load(std::memory_order_acquire);
     const std::int64_t t0 = clock_();
     sensor_.process_image(f.frame.view, out.stages);
     out.stage_us = (clock_() - t0) / 1000;
@@ -24,12 +25,15 @@ void PadStager::stage(const ArrivedFrame& f, StagedFrame& out) noexcept {
   out.calibration_epoch = calibration_applied_;
 }
 
-void PadStager::apply_requests() noexcept {
-  const std::uint32_t tare = tare_requested_.load(std::memory_order_acquire);
-  if (tare != tare_applied_) {
-    sensor_.tare_image();
-    tare_applied_ = tare;
+void PadStager::run_deferred() noexcept {
+  sensor_.run_deferred();
+  if (tare_taken_ != tare_applied_) {
+    sensor_.tare_image();  // the frame just handed on becomes the reference
+    tare_applied_ = tare_taken_;
   }
+}
+
+void PadStager::apply_calibration() noexcept {
   int posted = kPosted;
   if (calibration_state_.compare_exchange_strong(posted, kBusy, std::memory_order_acquire)) {
     (void)sensor_.set_image_calibration(calibration_);  // validated by the DSP thread

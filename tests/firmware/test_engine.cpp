@@ -654,10 +654,11 @@ TEST_F(EngineTest, EarlierPadsImageStagesRunBeforeTheLaterFrameArrives) {
 }
 
 // A tare (or a calibration reload) between the earlier frame's image stages and the later
-// frame: the earlier frame is the last one before it (its pad's reference is taken from it and
-// its motion restarts after it; it finishes on the old calibration), the later pad's frame the
-// first one after it. Each applies once: the cycles after it equal the reference run's with the
-// same tare and reload, bit for bit.
+// frame. A pad takes it when its next frame's stages start: the later pad at this cycle's frame,
+// the earlier pad at the next cycle's. A reload applies to that frame; a tare makes that frame
+// the reference once handed on, and the pad's motion restarts at its following frame. The pose
+// and the pair's filters restart at once. Each applies once: the cycles equal the reference
+// run's with the same tare and reload, bit for bit.
 TEST_F(EngineTest, TareOrReloadDuringACycleAppliesToEachPadsNextFrameOnce) {
   auto reference = std::make_unique<dsp::DualPipeline>();
   configure(*reference);
@@ -689,15 +690,19 @@ TEST_F(EngineTest, TareOrReloadDuringACycleAppliesToEachPadsNextFrameOnce) {
     }
     if (i == kTareAt) {
       reference->process_pad(dsp::SensorSlot::kLeft, lv, (*stages)[0]);
-      for (dsp::SensorSlot s : {dsp::SensorSlot::kLeft, dsp::SensorSlot::kRight}) {
-        reference->sensor_mut(s).tare_image();
-      }
-      reference->sensor_mut(dsp::SensorSlot::kRight).reset_motion();
       reference->restart_filters();
       reference->reset_pose();
       reference->process_pad(dsp::SensorSlot::kRight, rv, (*stages)[1]);
       reference->finish(&(*stages)[0], &(*stages)[1], t_right, want);
-      reference->sensor_mut(dsp::SensorSlot::kLeft).reset_motion();
+      for (dsp::SensorSlot s : {dsp::SensorSlot::kLeft, dsp::SensorSlot::kRight}) {
+        reference->sensor_mut(s).run_deferred();
+      }
+      reference->sensor_mut(dsp::SensorSlot::kRight).tare_image();
+      reference->sensor_mut(dsp::SensorSlot::kRight).reset_motion();  // from frame i + 1
+    } else if (i == kTareAt + 1) {
+      reference->process(&lv, &rv, t_right, want);
+      reference->sensor_mut(dsp::SensorSlot::kLeft).tare_image();
+      reference->sensor_mut(dsp::SensorSlot::kLeft).reset_motion();  // from frame i + 2
     } else if (i == kReloadAt) {
       reference->process_pad(dsp::SensorSlot::kLeft, lv, (*stages)[0]);
       ASSERT_EQ(reference->set_pair_calibration({reloaded, reloaded}), dsp::Status::kOk);
@@ -720,11 +725,11 @@ TEST_F(EngineTest, TareOrReloadDuringACycleAppliesToEachPadsNextFrameOnce) {
   for (std::size_t i = 0; i < kEnd; ++i) EXPECT_EQ(b.cycles[i].pose_reset, i == kTareAt) << i;
 }
 
-// Each pad's image stages on its own thread, as the daemon's capture threads run them, with a
-// tare and a calibration reload requested while the left pad's thread is in a frame's stages
-// (the left frame is the last before them, the right frame the first after): every pair equals
-// the single-threaded engine's (stages on the stepping thread, the requests between the two
-// frames) bit for bit.
+// Each pad's image stages and deferred work on its own thread, as the daemon's capture threads
+// run them, with a tare and a calibration reload requested while the left pad's thread is in a
+// frame's stages (the left pad takes them at its next frame, the right at this one): every pair
+// equals the single-threaded engine's (stages on the stepping thread, the requests between the
+// two frames) bit for bit.
 TEST_F(EngineTest, PadThreadsGiveTheSingleThreadedEnginesPairsBitForBit) {
   auto pipeline = std::make_unique<dsp::DualPipeline>();
   configure(*pipeline);
@@ -753,6 +758,7 @@ TEST_F(EngineTest, PadThreadsGiveTheSingleThreadedEnginesPairsBitForBit) {
       }
       threaded->stager(s).stage(a, *slot);
       (*staged)[s].commit();
+      threaded->stager(s).run_deferred();
     }
   };
   std::thread left(pad, 0), right(pad, 1);

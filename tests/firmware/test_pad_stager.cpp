@@ -48,10 +48,13 @@ class PadStagerTest : public ::testing::Test {
     ASSERT_EQ(pad_->configure(dsp::PipelineConfig{}, cal_), dsp::Status::kOk);
     ASSERT_EQ(ref_->configure(dsp::PipelineConfig{}, cal_), dsp::Status::kOk);
   }
-  // Stages frame i on the stager and on the reference; true when their outputs are equal.
-  bool stage_both(std::size_t i) {
+  // Stages frame i on the stager and on the reference, each followed by its deferred work (as a
+  // pad's thread runs it once the frame is handed on); true when their outputs are equal.
+  bool stage_both(std::size_t i, bool deferred = true) {
     stager_.stage(arrived(frames_[i], 1000 + static_cast<std::int64_t>(i)), *out_);
+    if (deferred) stager_.run_deferred();
     ref_->process_image(arrived(frames_[i], 0).frame.view, *want_);
+    ref_->run_deferred();
     return out_->staged && out_->stages.shear.x.v == want_->shear.x.v &&
            out_->stages.shear.y.v == want_->shear.y.v &&
            out_->stages.contact.mask.v == want_->contact.mask.v;
@@ -79,16 +82,28 @@ TEST_F(PadStagerTest, StagesLikeTheSensorPipelineAndSkipsALateFrame) {
   EXPECT_TRUE(stage_both(4));
 }
 
-TEST_F(PadStagerTest, ATareAppliesBeforeTheNextFrameAndStampsIt) {
+// The frame whose stages take the request still runs on the old reference and becomes the new
+// one once handed on; the frames staged after it carry the new epoch. A request made while a
+// frame's stages run waits for the next frame.
+TEST_F(PadStagerTest, ATareTakesTheNextFrameAsReferenceAndStampsTheFramesAfter) {
   ASSERT_TRUE(stage_both(0));
   ASSERT_TRUE(stage_both(1));
   EXPECT_EQ(out_->tare_epoch, 0u);
   EXPECT_EQ(stager_.request_tare(), 1u);
-  ref_->tare_image();  // the reference becomes frame 1, the last staged
   ASSERT_TRUE(stage_both(2));
-  EXPECT_EQ(out_->tare_epoch, 1u);
+  EXPECT_EQ(out_->tare_epoch, 0u) << "frame 2 ran on the old reference";
+  ref_->tare_image();  // the reference becomes frame 2
   ASSERT_TRUE(stage_both(3));
+  EXPECT_EQ(out_->tare_epoch, 1u);
+  ASSERT_TRUE(stage_both(4, false));
   EXPECT_EQ(out_->tare_epoch, 1u) << "applied once";
+  EXPECT_EQ(stager_.request_tare(), 2u);  // during frame 4, after its stages took the requests
+  stager_.run_deferred();
+  ASSERT_TRUE(stage_both(5));
+  EXPECT_EQ(out_->tare_epoch, 1u) << "frame 5 took the request";
+  ref_->tare_image();  // the reference becomes frame 5
+  ASSERT_TRUE(stage_both(0));
+  EXPECT_EQ(out_->tare_epoch, 2u);
 }
 
 TEST_F(PadStagerTest, AnUntakenCalibrationIsReplacedATakenOneWaitsForItsMotionHalf) {

@@ -40,12 +40,14 @@ struct StagedFrame {
 using StagedRing = hal::SpscRing<StagedFrame, 8>;
 
 // Owns one pad's image state (SensorPipeline::process_image, tare_image, set_image_calibration):
-// stage() is called by one thread only, the pad's; the other members by the DSP thread. The DSP
-// thread asks, the pad thread applies before its next frame's stages and stamps that frame with
-// the epoch it applied, so the DSP thread applies the motion half (reset_motion,
-// set_motion_calibration) exactly at the first frame staged after the request: the frames
-// staged before a tare are the last of the old reference, as a tare between two frames of one
-// thread. No lock, no allocation; each request is one atomic store.
+// stage() and run_deferred() are called by one thread only, the pad's; the other members by the
+// DSP thread. The DSP thread asks; the pad thread takes a request when its next frame's stages
+// start. It applies a calibration there, and a tare once that frame is handed on (run_deferred:
+// the frame becomes the reference, and the model build is off the cycle's latency). It stamps
+// every frame with the epochs it was staged under, so the DSP thread applies the motion half
+// (reset_motion, set_motion_calibration) exactly at the first frame staged after the pad applied
+// the request: the frames staged before it are the last of the old reference, as a tare between
+// two frames of one thread. No lock, no allocation; each request is one atomic store.
 class PadStager {
  public:
   PadStager(dsp::SensorPipeline& sensor, std::int64_t (*clock)() noexcept) noexcept
@@ -57,15 +59,16 @@ class PadStager {
   // frame that entered no cycle, as when the camera delivers one that pairing drops.
   void stage(const ArrivedFrame& f, StagedFrame& out) noexcept;
   // Pad thread, once the staged frame is handed on: the image work only the next frame needs (a
-  // keyframe switch, dsp::SensorPipeline::run_deferred), off the cycle's latency.
-  void run_deferred() noexcept { sensor_.run_deferred(); }
+  // keyframe switch, dsp::SensorPipeline::run_deferred), then a requested tare, off the cycle's
+  // latency.
+  void run_deferred() noexcept;
 
   // DSP thread: the sample time of the last processed sample (frames not newer are late).
   void set_last_sample(std::int64_t t_ns) noexcept {
     last_t_ns_.store(t_ns, std::memory_order_release);
   }
-  // DSP thread: re-take the reference before the next frame. Returns the tare epoch the next
-  // staged frame carries.
+  // DSP thread: the next frame whose stages start becomes the reference once handed on. Returns
+  // the tare epoch the frames staged after it carry.
   std::uint32_t request_tare() noexcept {
     return tare_requested_.fetch_add(1, std::memory_order_release) + 1;
   }
@@ -85,7 +88,7 @@ class PadStager {
   bool take_view_fields(viewer::ViewPad* out, int* contact_cells) noexcept;
 
  private:
-  void apply_requests() noexcept;
+  void apply_calibration() noexcept;
 
   enum : int { kIdle = 0, kPosted, kBusy };  // calibration mailbox: who holds calibration_
   // view_: the pad thread writes it while kViewWanted, the DSP thread reads it while kViewFilled.
@@ -95,6 +98,7 @@ class PadStager {
   std::int64_t (*clock_)() noexcept;
   std::atomic<std::int64_t> last_t_ns_{INT64_MIN};
   std::atomic<std::uint32_t> tare_requested_{0};
+  std::uint32_t tare_taken_ = 0;    // pad thread: the request its last frame's stages took
   std::uint32_t tare_applied_ = 0;  // pad thread
   std::atomic<int> calibration_state_{kIdle};
   dsp::Calibration calibration_{};  // held by whoever set calibration_state_ to kBusy
