@@ -497,7 +497,6 @@ void BlockFlow::build_level0() noexcept {
   int count = 0;
   for (int i = 0; i < kGridCount; ++i) count += level0[i].valid;
   keyframe_valid_count_ = count;
-  level0_pending_ = false;
 }
 
 void BlockFlow::build_coarse() noexcept {
@@ -513,7 +512,6 @@ void BlockFlow::build_coarse() noexcept {
 void BlockFlow::complete_keyframe() noexcept {
   if (!has_reference_) return;
   run_deferred();
-  if (level0_pending_) build_level0();
   build_coarse();
 }
 
@@ -1049,11 +1047,10 @@ void BlockFlow::switch_keyframe() noexcept {
   key_coarse_pyramid_ = coarse_built_;
   cur_index_ = 1 - cur_index_;
   window_flow_ = VectorField{};
-  // Its window models are built later (see track()): level 0 at the start of the next frame,
-  // the coarse levels when a coarse pass first needs them or in the frame after that. They
-  // depend only on the keyframe image and displacement, fixed from here on.
+  // Its level-0 models follow at once (run_deferred()), the coarse levels when a coarse pass
+  // first needs them or in the frame after. They depend only on the keyframe image and
+  // displacement, fixed from here on.
   key_level0_is_tare_ = false;
-  level0_pending_ = true;
   coarse_pending_ = config_.pyramid_levels > 1;
 }
 
@@ -1180,7 +1177,6 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
   // the warm start is within a fraction of a pixel and level 0 alone converges.
   // The keyframe's window models are built in bounded pieces (see complete_keyframe()).
   run_deferred();
-  if (level0_pending_) build_level0();
   ImagePyramid& cur = pyramid_[static_cast<std::size_t>(cur_index_)];
   build_pyramid(frame, 1, cur);
   coarse_built_ = false;

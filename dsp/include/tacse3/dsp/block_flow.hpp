@@ -252,7 +252,6 @@ class BlockFlow {
   bool coarse_built_ = false;        // coarse pyramid levels of the current frame exist
   bool key_coarse_pyramid_ = false;  // coarse pyramid levels of the keyframe exist
   bool key_level0_is_tare_ = false;  // level_models(0) is the tare frame's set
-  bool level0_pending_ = false;      // the keyframe's level-0 models are still to be built
   bool coarse_pending_ = false;      // its coarse-level models are still to be built
   int valid_count_ = 0;
   int keyframe_valid_count_ = 0;
