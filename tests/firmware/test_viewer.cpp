@@ -13,10 +13,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -361,22 +363,29 @@ double median(std::vector<double> v) {
 }
 
 // A client that asks for /api/stream and never reads: a 4 KiB receive buffer that the stream
-// fills within a second. -1 when it cannot connect.
+// fills within a second. The socket, or -errno of the last attempt when it cannot connect. A loaded
+// machine can refuse a connection for a moment (a full accept backlog while the server's thread
+// waits for a core), so it tries for up to 5 s.
 int mute_client(int port) {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  const int small = 4096;
-  setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  const std::string req = "GET /api/stream HTTP/1.1\r\nHost: test\r\n\r\n";
-  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0 ||
-      send(fd, req.data(), req.size(), 0) != static_cast<ssize_t>(req.size())) {
+  int err = 0;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    const int small = 4096;
+    setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const std::string req = "GET /api/stream HTTP/1.1\r\nHost: test\r\n\r\n";
+    if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
+        send(fd, req.data(), req.size(), 0) == static_cast<ssize_t>(req.size())) {
+      return fd;
+    }
+    err = errno;
     close(fd);
-    return -1;
   }
-  return fd;
+  return err > 0 ? -err : -EIO;
 }
 
 // One paced run (the frames stamped on CLOCK_MONOTONIC, so the latency is real) with --http.
@@ -422,7 +431,10 @@ RunResult paced_run(const std::string& daemon_cmd, int port, bool clients,
   for (auto& t : readers) t.join();
   if (mute >= 0) close(mute);
   if (!live) d.status = -1;
-  if (clients && mute < 0) d.status = -2;
+  if (live && clients && mute < 0) {
+    d.status = -2;
+    d.out += std::string("mute client: ") + std::strerror(-mute) + "\n";
+  }
   return d;
 }
 
