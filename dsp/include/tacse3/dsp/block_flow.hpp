@@ -233,6 +233,7 @@ class BlockFlow {
                             int iterations) const noexcept;
   void coarse_to_fine() noexcept;
   void write_output(VectorField& displacement, GridMask& valid) noexcept;
+  void update_stencils() noexcept;
   bool keyframe_switch_due() const noexcept;
   void switch_keyframe() noexcept;
   void re_anchor() noexcept;
@@ -280,6 +281,12 @@ class BlockFlow {
   VectorField centre_{};
   std::array<std::array<std::int32_t, 4>, kGridCount> jacobian_{};
   std::array<std::array<JacobianStencil, 2>, kGridCount> stencil_{};
+  // The inputs the stencils were built from: they are rebuilt only when the valid mask or the
+  // window origins changed, which in a steady grasp is rare.
+  bool stencil_built_ = false;
+  GridMask stencil_mask_{};
+  std::array<std::int16_t, kGridCount> stencil_origin_x_{};
+  std::array<std::int16_t, kGridCount> stencil_origin_y_{};
   // re_anchor() scratch.
   VectorField reanchor_reported_{};
   VectorField reanchor_chained_{};
