@@ -3,9 +3,12 @@
 #include "tacse3/sim/profile.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
+#include <system_error>
 
 #include "tacse3/sim/rng.hpp"
 #include "tacse3/sim/simulator.hpp"
@@ -185,6 +188,15 @@ std::string number(double v) {
   return buf;
 }
 
+// "random:N" with N a decimal number below 2^64: *sensor = N.
+bool parse_random_sensor(std::string_view name, std::uint64_t* sensor) {
+  constexpr std::string_view kPrefix = "random:";
+  if (name.substr(0, kPrefix.size()) != kPrefix || name.size() == kPrefix.size()) return false;
+  const std::string_view digits = name.substr(kPrefix.size());
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), *sensor);
+  return ec == std::errc{} && end == digits.data() + digits.size();
+}
+
 }  // namespace
 
 const char* profile_names() noexcept {
@@ -205,9 +217,14 @@ bool make_profile(std::string_view name, std::uint64_t seed, SensorProfile* out,
     *out = halfspace_mjpeg();
   } else if (name == "random") {
     *out = random_profile(seed);
+  } else if (std::uint64_t sensor = 0; parse_random_sensor(name, &sensor)) {
+    // One sensor: the physics drawn by its own number, whatever the recording's seed.
+    *out = random_profile(sensor);
+    out->name = std::string(name);
   } else {
     if (error)
-      *error = "unknown profile \"" + std::string(name) + "\" (one of: " + profile_names() + ")";
+      *error = "unknown profile \"" + std::string(name) + "\" (one of: " + profile_names() +
+               ", or random:N for one sensor of the random profile)";
     return false;
   }
   return true;

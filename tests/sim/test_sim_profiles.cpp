@@ -126,6 +126,23 @@ TEST(SimProfiles, RandomProfileIsDeterministicBySeed) {
   EXPECT_EQ(profile_values(profile("soft-thick", 1)), profile_values(profile("soft-thick", 2)));
 }
 
+// "random:N" is one sensor: random's draw for N, whatever the recording's seed.
+TEST(SimProfiles, ANumberedRandomSensorKeepsItsPhysicsOverSeeds) {
+  const SensorProfile a = profile("random:7", 1);
+  const SensorProfile b = profile("random:7", 99);
+  EXPECT_EQ(a.name, "random:7");
+  EXPECT_EQ(profile_values(a), profile_values(b));
+  EXPECT_EQ(profile_values(a), profile_values(profile("random", 7)));
+  EXPECT_NE(profile_values(a), profile_values(profile("random:8", 1)));
+  SensorProfile p;
+  std::string error;
+  for (const char* bad : {"random:", "random:x", "random:1x", "random:-1", "random:+1", "random: 1",
+                          "random:99999999999999999999"}) {
+    EXPECT_FALSE(make_profile(bad, 1, &p, &error)) << bad;
+    EXPECT_NE(error.find("random:N"), std::string::npos) << error;
+  }
+}
+
 TEST(SimProfiles, RandomProfileStaysInItsRanges) {
   std::set<BulgeModel> bulge;
   std::set<SlideLaw> slide;

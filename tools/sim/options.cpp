@@ -32,7 +32,9 @@ int parse_options(int argc, char** argv, Options* o) {
       ->capture_default_str();
   app.add_option("--profile", o->profile,
                  std::string("Sensor profile (docs/sim-profiles.md): ") +
-                     tacse3::sim::profile_names() + "; \"list\" prints them with their values")
+                     tacse3::sim::profile_names() +
+                     "; random:N, the random profile's sensor N in every recording; \"list\" "
+                     "prints them with their values")
       ->capture_default_str();
   app.add_option("--seed", o->seed,
                  "Seed of the pattern, noise, flicker, bumpy shape and the random profile")

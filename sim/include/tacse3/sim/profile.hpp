@@ -33,7 +33,8 @@ struct SensorProfile {
 const char* profile_names() noexcept;
 
 // Fills *out with the named profile. "random" draws every value from the documented ranges
-// with `seed`; the named ones ignore it. False (with *error naming the choices) if unknown.
+// with `seed`; "random:N" draws them with N instead, so every recording of it is of one sensor;
+// the named ones ignore the seed. False (with *error naming the choices) if unknown.
 bool make_profile(std::string_view name, std::uint64_t seed, SensorProfile* out,
                   std::string* error);
 
