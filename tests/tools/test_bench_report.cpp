@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "cases.hpp"
 #include "report.hpp"
+#include "tacse3/tools/bench.hpp"
 
 namespace ba = tacse3::bench_accuracy;
 
@@ -92,4 +95,17 @@ TEST(BenchReport, AProfileThatFailsToCalibrateFailsTheCheck) {
   const std::string m = ba::goal_matrix(p, 0.0, &failed);
   ASSERT_EQ(failed.size(), 1u);
   EXPECT_NE(m.find("failed"), std::string::npos);
+}
+
+// `all` is the named profiles and three random sensors; a random sensor can also be named.
+TEST(BenchReport, AllIsTheNamedProfilesAndThreeRandomSensors) {
+  std::vector<std::string> list;
+  ASSERT_EQ(tacse3::tools::parse_profile_list("all", &list), "");
+  EXPECT_EQ(list,
+            (std::vector<std::string>{"reference", "soft-thick", "stiff-thin", "coulomb-rim",
+                                      "halfspace-mjpeg", "random:1", "random:2", "random:3"}));
+  ASSERT_EQ(tacse3::tools::parse_profile_list("random,random:12,soft-thick", &list), "");
+  EXPECT_EQ(list, (std::vector<std::string>{"random", "random:12", "soft-thick"}));
+  EXPECT_NE(tacse3::tools::parse_profile_list("reference,random:x", &list).find("random:x"),
+            std::string::npos);
 }

@@ -60,25 +60,30 @@ std::string SimCase::sim_arguments() const {
 }
 
 std::string parse_profile_list(const std::string& text, std::vector<std::string>* out) {
-  std::vector<std::string> known;
   const std::string names = sim::profile_names();
-  for (std::size_t start = 0; start < names.size();) {
-    const std::size_t end = std::min(names.find(", ", start), names.size());
-    known.push_back(names.substr(start, end - start));
-    start = end + 2;
-  }
   out->clear();
   if (text == "all") {
-    *out = known;
+    // The named profiles and three sensors of the random profile. Each is one physics in every
+    // recording, as a calibration is of one sensor; "random" itself, another sensor in each
+    // recording, is run when asked for by name.
+    for (std::size_t start = 0; start < names.size();) {
+      const std::size_t end = std::min(names.find(", ", start), names.size());
+      if (names.compare(start, end - start, "random") != 0) {
+        out->push_back(names.substr(start, end - start));
+      }
+      start = end + 2;
+    }
+    for (const char* sensor : {"random:1", "random:2", "random:3"}) out->push_back(sensor);
     return {};
   }
   std::size_t start = 0;
   while (start <= text.size()) {
     const std::size_t end = std::min(text.find(',', start), text.size());
     const std::string name = text.substr(start, end - start);
-    if (std::find(known.begin(), known.end(), name) == known.end()) {
+    sim::SensorProfile p;
+    if (!sim::make_profile(name, 0, &p, nullptr)) {
       std::string e = "unknown profile \"";
-      e.append(name).append("\" (one of: ").append(names).append(", or all)");
+      e.append(name).append("\" (one of: ").append(names).append(", random:N, or all)");
       return e;
     }
     out->push_back(name);
