@@ -439,13 +439,17 @@ TEST_F(ViewServerTest, ConnectionsBeyondTheLimitAreRefusedAtOnce) {
   }
   EXPECT_EQ(server_->stats().connections_refused, static_cast<std::uint64_t>(kExtra));
   for (int s : idle) close(s);
-  bool served = false;
-  for (int i = 0; i < 40 && !served; ++i) {
-    served = status_of(exchange(port(), get("/api/state"))) == 200;
-    if (!served) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  EXPECT_TRUE(served) << "/api/state not served within 2 s of the idle connections closing";
-  EXPECT_EQ(status_of(exchange(port(), get("/api/image/left.jpg"))), 200);
+  // The server frees each idle connection's place when its thread reads the close, one after
+  // another, so on a loaded machine a place may still be held for a moment after the first 200.
+  const auto served_within_2s = [&](const char* path) {
+    for (int i = 0; i < 40; ++i) {
+      if (status_of(exchange(port(), get(path))) == 200) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return false;
+  };
+  EXPECT_TRUE(served_within_2s("/api/state")) << "not served within 2 s of the idle ones closing";
+  EXPECT_TRUE(served_within_2s("/api/image/left.jpg")) << "not served within 2 s";
 }
 
 TEST_F(ViewServerTest, CommandsAreRefusedNamingTheBoardKeyWhenTheControlsAreOff) {
