@@ -112,6 +112,32 @@ class ViewerTest : public ::testing::Test {
   int port_ = 0;
 };
 
+// A client that asks for /api/stream and never reads: a 4 KiB receive buffer that the stream
+// fills within a second. The socket, or -errno of the last attempt when it cannot connect. A loaded
+// machine can refuse a connection for a moment (a full accept backlog while the server's thread
+// waits for a core), so it tries for up to 5 s.
+int mute_client(int port) {
+  int err = 0;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    const int small = 4096;
+    setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const std::string req = "GET /api/stream HTTP/1.1\r\nHost: test\r\n\r\n";
+    if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
+        send(fd, req.data(), req.size(), 0) == static_cast<ssize_t>(req.size())) {
+      return fd;
+    }
+    err = errno;
+    close(fd);
+  }
+  return err > 0 ? -err : -EIO;
+}
+
 }  // namespace
 
 TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) {
@@ -140,16 +166,8 @@ TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) 
   EXPECT_NE(cli.Get("/api/info")->body.find("\"controls\":false,"), std::string::npos);
 
   // The client that never reads: its stream fills the socket buffers and must stall nothing.
-  const int mute = socket(AF_INET, SOCK_STREAM, 0);
-  const int small = 4096;
-  setsockopt(mute, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<std::uint16_t>(port_));
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(connect(mute, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
-  const std::string req = "GET /api/stream HTTP/1.1\r\nHost: test\r\n\r\n";
-  ASSERT_EQ(send(mute, req.data(), req.size(), 0), static_cast<ssize_t>(req.size()));
+  const int mute = mute_client(port_);
+  ASSERT_GE(mute, 0) << std::strerror(-mute);
 
   // Three reading clients on the stream.
   std::atomic<bool> stop{false};
@@ -360,32 +378,6 @@ EngineTiming summary_timing(const std::string& out) {
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];  // odd sizes only here
-}
-
-// A client that asks for /api/stream and never reads: a 4 KiB receive buffer that the stream
-// fills within a second. The socket, or -errno of the last attempt when it cannot connect. A loaded
-// machine can refuse a connection for a moment (a full accept backlog while the server's thread
-// waits for a core), so it tries for up to 5 s.
-int mute_client(int port) {
-  int err = 0;
-  for (int attempt = 0; attempt < 50; ++attempt) {
-    if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    const int fd = socket(AF_INET, SOCK_STREAM, 0);
-    const int small = 4096;
-    setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(static_cast<std::uint16_t>(port));
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    const std::string req = "GET /api/stream HTTP/1.1\r\nHost: test\r\n\r\n";
-    if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
-        send(fd, req.data(), req.size(), 0) == static_cast<ssize_t>(req.size())) {
-      return fd;
-    }
-    err = errno;
-    close(fd);
-  }
-  return err > 0 ? -err : -EIO;
 }
 
 // One paced run (the frames stamped on CLOCK_MONOTONIC, so the latency is real) with --http.
