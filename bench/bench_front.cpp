@@ -35,13 +35,14 @@ test::Photometric photometric(std::uint64_t seed, double gain) {
 
 // scalar: frame_to_work_image_scalar, the reference for the SIMD path's speed-up
 // (docs/performance.md).
-void luma(benchmark::State& state, PixelFormat format, bool scalar = false) {
+void luma(benchmark::State& state, PixelFormat format, bool scalar = false,
+          tacse3::dsp::WorkImageFilter filter = tacse3::dsp::WorkImageFilter::kBox) {
   const auto bytes = test::render_frame(texture(), test::Warp::identity(), format);
   const auto view = test::frame_view(bytes, format);
   WorkImage out;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(scalar ? tacse3::dsp::frame_to_work_image_scalar(view, out)
-                                    : tacse3::dsp::frame_to_work_image(view, out));
+    benchmark::DoNotOptimize(scalar ? tacse3::dsp::frame_to_work_image_scalar(view, out, filter)
+                                    : tacse3::dsp::frame_to_work_image(view, out, filter));
     benchmark::ClobberMemory();
   }
 }
@@ -63,12 +64,25 @@ void BM_LumaYuyvScalar(benchmark::State& state) {
 void BM_LumaGreyScalar(benchmark::State& state) {
   luma(state, PixelFormat::kGrey, true);
 }
+// The binomial working image (antialias_filter = 1).
+void BM_LumaBinomialRgb888(benchmark::State& state) {
+  luma(state, PixelFormat::kRgb888, false, tacse3::dsp::WorkImageFilter::kBinomial);
+}
+void BM_LumaBinomialGrey(benchmark::State& state) {
+  luma(state, PixelFormat::kGrey, false, tacse3::dsp::WorkImageFilter::kBinomial);
+}
+void BM_LumaBinomialRgb888Scalar(benchmark::State& state) {
+  luma(state, PixelFormat::kRgb888, true, tacse3::dsp::WorkImageFilter::kBinomial);
+}
 BENCHMARK(BM_LumaRgb888);
 BENCHMARK(BM_LumaYuyv);
 BENCHMARK(BM_LumaGrey);
 BENCHMARK(BM_LumaRgb888Scalar);
 BENCHMARK(BM_LumaYuyvScalar);
 BENCHMARK(BM_LumaGreyScalar);
+BENCHMARK(BM_LumaBinomialRgb888);
+BENCHMARK(BM_LumaBinomialGrey);
+BENCHMARK(BM_LumaBinomialRgb888Scalar);
 
 void BM_Pyramid3(benchmark::State& state) {
   const WorkImage img = test::render_work_image(texture(), test::Warp::identity());

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// tacse3 dsp: camera frame to U8.2 working image (luma + 2x2 box sum).
+// tacse3 dsp: camera frame to U8.2 working image (luma, then the 2x2 box or the 4x4 binomial
+// and 2:1 decimation).
 #include "tacse3/dsp/luma.hpp"
 
 #include <array>
@@ -17,7 +18,7 @@ bool known_format(PixelFormat f) noexcept {
   return f == PixelFormat::kRgb888 || f == PixelFormat::kYuyv || f == PixelFormat::kGrey;
 }
 
-// The scalar path: one output row from two input rows. Each kernel is a plain counted loop over
+// kBox's scalar path: one output row from two input rows. Each kernel is a plain counted loop over
 // contiguous bytes so that g++ -O2 can vectorise it.
 void grey_row(const std::uint8_t* __restrict r0, const std::uint8_t* __restrict r1,
               std::uint16_t* __restrict out) noexcept {
@@ -63,6 +64,21 @@ void rgb_row(const std::uint8_t* __restrict r0, const std::uint8_t* __restrict r
   }
 }
 
+// kBinomial's scalar steps: plain counted loops that g++ -O2 may vectorise.
+void luma_row(PixelFormat format, const std::uint8_t* __restrict row,
+              std::uint16_t* __restrict y) noexcept {
+  for (int i = 0; i < kSensorWidth; ++i) y[i] = detail::luma_q8(format, row, i);
+}
+
+void decimate_row(const std::uint16_t* __restrict y, std::uint32_t* __restrict h) noexcept {
+  for (int x = 0; x < kWorkWidth; ++x) h[x] = detail::decimate_px(y, x);
+}
+
+void vertical_row(const std::uint32_t* m1, const std::uint32_t* a, const std::uint32_t* b,
+                  const std::uint32_t* c, std::uint16_t* __restrict out) noexcept {
+  for (int x = 0; x < kWorkWidth; ++x) out[x] = detail::vertical_px(m1, a, b, c, x);
+}
+
 std::size_t frame_stride(const FrameView& in) noexcept {
   return static_cast<std::size_t>(in.stride_bytes == 0 ? packed_row_bytes(in.format)
                                                        : in.stride_bytes);
@@ -84,17 +100,30 @@ Status check_frame(const FrameView& in) noexcept {
   return Status::kOk;
 }
 
-Status frame_to_work_image(const FrameView& in, WorkImage& out) noexcept {
+Status frame_to_work_image(const FrameView& in, WorkImage& out, WorkImageFilter filter) noexcept {
   const Status s = check_frame(in);
   if (s != Status::kOk) return s;
-  detail::luma_image_simd(in.format, in.data, frame_stride(in), out.px.data());
+  if (filter == WorkImageFilter::kBinomial) {
+    detail::luma_binomial_simd(in.format, in.data, frame_stride(in), out.px.data());
+  } else {
+    detail::luma_image_simd(in.format, in.data, frame_stride(in), out.px.data());
+  }
   return Status::kOk;
 }
 
-Status frame_to_work_image_scalar(const FrameView& in, WorkImage& out) noexcept {
+Status frame_to_work_image_scalar(const FrameView& in, WorkImage& out,
+                                  WorkImageFilter filter) noexcept {
   const Status s = check_frame(in);
   if (s != Status::kOk) return s;
   const std::size_t stride = frame_stride(in);
+  if (filter == WorkImageFilter::kBinomial) {
+    const PixelFormat format = in.format;
+    detail::filter_frame(
+        in.data, stride, out.px.data(),
+        [format](const std::uint8_t* row, std::uint16_t* y) { luma_row(format, row, y); },
+        decimate_row, vertical_row);
+    return Status::kOk;
+  }
   for (int y = 0; y < kWorkHeight; ++y) {
     const std::uint8_t* r0 = in.data + stride * static_cast<std::size_t>(2 * y);
     const std::uint8_t* r1 = r0 + stride;

@@ -71,19 +71,22 @@ void expect_luma_equal(const std::vector<std::uint8_t>& bytes, PixelFormat forma
   v.height = kSensorHeight;
   v.stride_bytes = pad == 0 ? 0 : row_bytes(format) + pad;
   v.format = format;
-  WorkImage scalar;
-  WorkImage simd;
-  scalar.px.fill(0xBEEF);
-  simd.px.fill(0x1234);
-  ASSERT_EQ(frame_to_work_image_scalar(v, scalar), Status::kOk);
-  ASSERT_EQ(frame_to_work_image(v, simd), Status::kOk);
-  int mismatches = 0;
-  for (std::size_t p = 0; p < scalar.px.size(); ++p) {
-    if (scalar.px[p] != simd.px[p] && ++mismatches <= 5) {
-      ADD_FAILURE() << "pixel " << p << ": scalar " << scalar.px[p] << ", SIMD " << simd.px[p];
+  for (const WorkImageFilter filter : {WorkImageFilter::kBox, WorkImageFilter::kBinomial}) {
+    SCOPED_TRACE(filter == WorkImageFilter::kBox ? "box" : "binomial");
+    WorkImage scalar;
+    WorkImage simd;
+    scalar.px.fill(0xBEEF);
+    simd.px.fill(0x1234);
+    ASSERT_EQ(frame_to_work_image_scalar(v, scalar, filter), Status::kOk);
+    ASSERT_EQ(frame_to_work_image(v, simd, filter), Status::kOk);
+    int mismatches = 0;
+    for (std::size_t p = 0; p < scalar.px.size(); ++p) {
+      if (scalar.px[p] != simd.px[p] && ++mismatches <= 5) {
+        ADD_FAILURE() << "pixel " << p << ": scalar " << scalar.px[p] << ", SIMD " << simd.px[p];
+      }
     }
+    EXPECT_EQ(mismatches, 0);
   }
-  EXPECT_EQ(mismatches, 0);
 }
 
 const PixelFormat kFormats[] = {PixelFormat::kRgb888, PixelFormat::kYuyv, PixelFormat::kGrey};
@@ -109,7 +112,8 @@ TEST(SimdLuma, SaturatedAndAlternatingFramesEqualScalar) {
   for_each_target([] {
     for (PixelFormat f : kFormats) {
       SCOPED_TRACE("format " + std::to_string(static_cast<int>(f)));
-      // All 255: every block sum at its 1020 maximum, the RGB weighted sum at 261120.
+      // All 255: every block sum at its 1020 maximum, the RGB weighted sum at 261120 (the
+      // binomial's at 4177920).
       expect_luma_equal(make_frame(f, 0, [](std::size_t) { return std::uint8_t{255}; }), f, 0);
       expect_luma_equal(make_frame(f, 0, [](std::size_t) { return std::uint8_t{0}; }), f, 0);
       // 0/255 in every byte phase: a lane mix-up between pairs, channels or rows shows.

@@ -8,7 +8,7 @@ namespace tacse3::dsp {
 inline constexpr int kSensorWidth = 320;
 inline constexpr int kSensorHeight = 240;
 
-// Working image: luma, 2x2 box-downsampled (Sec. IV-B, "downsampled block flow").
+// Working image: luma, 2:1 downsampled (Sec. IV-B, "downsampled block flow"; luma.hpp).
 inline constexpr int kWorkScale = 2;
 inline constexpr int kWorkWidth = kSensorWidth / kWorkScale;    // 160
 inline constexpr int kWorkHeight = kSensorHeight / kWorkScale;  // 120

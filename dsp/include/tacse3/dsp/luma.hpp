@@ -34,10 +34,23 @@ constexpr int packed_row_bytes(PixelFormat format) noexcept {
 // or size_bytes below (height - 1) * stride + row bytes -> kBadFrameSize.
 Status check_frame(const FrameView& in) noexcept;
 
-// Converts one sensor frame to the working image (paper Sec. IV-B input stage): luma, then a
-// 2x2 box sum, stored as U8.2 (luma * 4, 0..1020) in `out`.
+// How the sensor image is brought down to the 160x120 working image (the calibration key
+// antialias_filter picks one per sensor; docs/dsp/flow.md).
+enum class WorkImageFilter : std::uint8_t {
+  // Each working pixel is the sum of its 2x2 block: the sharpest image, fine while the printed
+  // pattern has four or more sensor pixels per period.
+  kBox,
+  // A 4x4 binomial low-pass ([1 3 3 1] along x and y, sensor pixels 2x - 1 .. 2x + 2 clamped to
+  // the frame) before the 2:1 decimation. A finer pattern folds into the working image as a
+  // moire that moves against the gel, and the flow then tracks the moire: at a 2.3-pixel
+  // period the box (cos(pi f)) passes 20 % of the amplitude, the binomial (cos^3) 0.8 %.
+  kBinomial,
+};
+
+// Converts one sensor frame to the working image (paper Sec. IV-B input stage): luma, then the
+// filter, stored as U8.2 (luma * 4, 0..1020) in `out`. YUYV uses only the Y bytes.
 //
-// Scaling and overflow:
+// Scaling and overflow, kBox:
 //  - GREY / YUYV: the four 8-bit luma samples of each 2x2 block are summed exactly
 //    (max 4 * 255 = 1020); no rounding, no saturation.
 //  - RGB888: the block's channel sums are weighted once,
@@ -45,11 +58,18 @@ Status check_frame(const FrameView& in) noexcept;
 //    i.e. the exact 2x2 sum of the unrounded Q8 luma, rounded half-up once (error <= 0.5 LSB of
 //    U8.2 against the real-valued sum). The weighted sum is at most 256 * 1020 = 261120 (int32).
 //    The result never exceeds 1020, so nothing saturates.
-//  - YUYV uses only the Y bytes; chroma is ignored.
+// Scaling and overflow, kBinomial:
+//  - Luma in Q8 per sensor pixel: GREY and YUYV are byte << 8; RGB888 is 77 R + 150 G + 29 B.
+//    Both are <= 65280 (uint16).
+//  - The filter along x sums to <= 8 * 65280 = 522240, along y to <= 4177920 (uint32).
+//  - out = (sum + 2048) >> 12, rounded half-up once (error <= 0.5 LSB of U8.2 against the
+//    real-valued filter); the result never exceeds 1020, so nothing saturates.
 // On any error status `out` is left untouched. Runs on the best SIMD target (simd.hpp).
-Status frame_to_work_image(const FrameView& in, WorkImage& out) noexcept;
+Status frame_to_work_image(const FrameView& in, WorkImage& out,
+                           WorkImageFilter filter = WorkImageFilter::kBox) noexcept;
 
 // The scalar path of frame_to_work_image: the same result, bit for bit (tests, benchmarks).
-Status frame_to_work_image_scalar(const FrameView& in, WorkImage& out) noexcept;
+Status frame_to_work_image_scalar(const FrameView& in, WorkImage& out,
+                                  WorkImageFilter filter = WorkImageFilter::kBox) noexcept;
 
 }  // namespace tacse3::dsp

@@ -55,7 +55,8 @@ struct FrameView {
   PixelFormat format = PixelFormat::kGrey;
 };
 
-// Working image: luma after the 2x2 box downsample, format U8.2 (luma * 4, range 0..1020).
+// Working image: luma after the 2:1 downsample (luma.hpp), format U8.2 (luma * 4, range
+// 0..1020).
 struct WorkImage {
   alignas(16) std::array<std::uint16_t, kWorkPixels> px{};
   std::uint16_t& at(int x, int y) noexcept {
