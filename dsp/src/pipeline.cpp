@@ -53,6 +53,7 @@ Status SensorPipeline::configure(const PipelineConfig& config, const Calibration
   (void)motion_.configure(cal);
   config_ = config;
   cal_ = cal;
+  image_filter_ = work_image_filter(cal);
   min_tracked_points_ =
       static_cast<int>(std::ceil(config.min_tracked_fraction * static_cast<double>(kGridCount)));
   tare_pending_ = true;
@@ -71,6 +72,14 @@ Status SensorPipeline::set_image_calibration(const Calibration& cal) noexcept {
   if (validate(cal) != Status::kOk) return Status::kBadCalibration;
   (void)forces_.configure(cal);
   (void)contact_.configure(cal);
+  if (work_image_filter(cal) != image_filter_) {
+    // Another filter gives another image: the reference and the keyframes no longer match it,
+    // so the next frame becomes the reference.
+    image_filter_ = work_image_filter(cal);
+    tare_pending_ = true;
+    nhhd_.reset();
+    contact_.reset();
+  }
   return Status::kOk;
 }
 
@@ -117,14 +126,14 @@ void SensorPipeline::process(const FrameView& frame, double dt_s, SensorResult& 
 void SensorPipeline::process_image(const FrameView& frame, PadStages& stages) noexcept {
   SensorResult& out = stages.result;
   out = SensorResult{};
-  // Stage 1 (Sec. IV-B): luma and 2x2 downsample. A malformed frame is rejected before any state
-  // is touched; check_frame and the conversion share the same rules.
+  // Stage 1 (Sec. IV-B): luma and the calibrated filter's 2:1 downsample. A malformed frame is
+  // rejected before any state is touched; check_frame and the conversion share the same rules.
   const Status input = check_frame(frame);
   if (input != Status::kOk) {
     out.status = input;
     return;
   }
-  (void)frame_to_work_image(frame, fields_.work);
+  (void)frame_to_work_image(frame, fields_.work, image_filter_);
 
   // Stage 2: block flow against the adaptive reference, Eq. (dense_flow).
   if (tare_pending_) {

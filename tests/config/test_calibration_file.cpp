@@ -442,7 +442,7 @@ TEST(CalibrationFile, EveryPrefixAndByteFlipFailsCleanly) {
 TEST(CalibrationFile, EveryCalibrationFieldHasAKey) {
   // If dsp::Calibration gains a field, the file must learn it (this list is the file's).
   const auto keys = cfg::sensor_keys();
-  EXPECT_EQ(keys.size(), 33u);
+  EXPECT_EQ(keys.size(), 34u);
   EXPECT_EQ(keys.front(), "pixel_pitch_m");
   EXPECT_EQ(std::count(keys.begin(), keys.end(), "velocity_proxy"), 1);
   // The eight thresholds of the stick/slip detector (VelocityProxy::kAuto).

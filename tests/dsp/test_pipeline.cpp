@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "support/scenes.hpp"
+#include "support/synthetic.hpp"
+#include "tacse3/dsp/luma.hpp"
 #include "tacse3/dsp/pipeline.hpp"
 #include "tacse3/dsp_ref/pipeline_ref.hpp"
 
@@ -255,6 +257,39 @@ INSTANTIATE_TEST_SUITE_P(Scenes, FixedVsReference, ::testing::ValuesIn(agreement
 // flow windows and a σ = 8 px smoothing, and Ω reaches a little beyond the sticking patch where
 // the gel has already relaxed, so the magnitudes come out low; the per-axis calibration scales
 // absorb that. What must hold exactly is the direction, the sign and the separation of the axes.
+// antialias_filter picks the working image's filter (luma.hpp). A calibration that changes it
+// makes the next frame the reference, since the old reference was another image; one that keeps
+// it leaves the reference alone.
+TEST(DualPipeline, ChangingTheWorkImageFilterRetakesTheReference) {
+  const test::DotTexture tex(5);
+  const auto bytes = test::render_frame(tex, test::Warp::identity(), PixelFormat::kGrey);
+  const FrameView v = test::frame_view(bytes, PixelFormat::kGrey);
+  WorkImage box, binomial;
+  ASSERT_EQ(frame_to_work_image(v, box, WorkImageFilter::kBox), Status::kOk);
+  ASSERT_EQ(frame_to_work_image(v, binomial, WorkImageFilter::kBinomial), Status::kOk);
+  ASSERT_NE(box.px, binomial.px);
+  auto p = std::make_unique<DualPipeline>();
+  auto st = std::make_unique<PadStages>();
+  std::array<Calibration, 2> cal{};
+  ASSERT_EQ(p->configure(DualConfig{}, cal), Status::kOk);
+  const auto step = [&] {
+    p->process_pad(SensorSlot::kLeft, v, *st);
+    return st->result.reference_taken;
+  };
+  const auto& work = p->sensor(SensorSlot::kLeft).fields().work;
+  EXPECT_TRUE(step());
+  EXPECT_FALSE(step());
+  EXPECT_EQ(work.px, box.px);
+  for (auto& c : cal) c.antialias_filter = 1;
+  ASSERT_EQ(p->set_calibration(cal), Status::kOk);
+  EXPECT_TRUE(step());
+  EXPECT_EQ(work.px, binomial.px);
+  ASSERT_EQ(p->set_calibration(cal), Status::kOk);
+  EXPECT_FALSE(step());
+  for (auto& c : cal) c.antialias_filter = 2;
+  EXPECT_EQ(p->set_calibration(cal), Status::kBadCalibration);
+}
+
 // docs/performance.md (Memory) quotes this size: both pads' state, no heap. The bound is the
 // budget that statement relies on.
 TEST(DualPipeline, StaticFootprint) {

@@ -122,6 +122,8 @@ check "fit: the plan's set covers every rule" test "$(grep -c 'do not determine'
 check "fit: reports the fitted pitch" contains "o5" "^pixel pitch: fitted 0.0[0-9]* mm/px .* from 1 stick translation(s); replaces the recordings' rig.pixel_pitch_mm 0.1 (fitted / claimed "
 grep 'FAILED$' "o5"
 check "fit: every recording explained" test "$(grep -c 'FAILED$' "o5")" -eq 0
+check "fit: the box's fit passes, so the file keeps the box" \
+  contains "o5" "^working image: 2x2 box (antialias_filter 0)"
 check "fit: explained, exit 0" test $rc -eq 0
 check "fit: file written" test -s "fit.toml"
 "$CAL" --check "fit.toml" "$@" -q > /dev/null 2>&1

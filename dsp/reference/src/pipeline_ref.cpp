@@ -43,7 +43,8 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
   degraded = false;
   // The luma stage is exact integer arithmetic (test_luma holds it against luma_ref), so the
   // reference starts from the same working image.
-  if (dsp::frame_to_work_image(frame, last_work_) != dsp::Status::kOk) return false;
+  if (dsp::frame_to_work_image(frame, last_work_, dsp::work_image_filter(cal_)) != dsp::Status::kOk)
+    return false;
   if (tare_pending_) {
     flow_stage_.tare(last_work_);
     tare_pending_ = false;

@@ -560,8 +560,11 @@ std::string check_calibration_recording(const SourceInfo& info) {
   return {};
 }
 
-std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateOptions& opt,
-                      CalibrateReport* report) {
+namespace {
+
+// One fit with the working-image filter that opt.start names.
+std::string calibrate_with_filter(const std::vector<FrameSource*>& sources,
+                                  const CalibrateOptions& opt, CalibrateReport* report) {
   if (sources.empty()) return "no recordings given";
   for (auto* s : sources) {
     if (std::string e = check_calibration_recording(s->info()); !e.empty()) return e;
@@ -1028,6 +1031,39 @@ std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateO
   return {};
 }
 
+}  // namespace
+
+// The 2x2 box first: it keeps the sharpest image. A pattern finer than the working grid
+// resolves folds into it as a moire that the flow tracks (dsp/luma.hpp); such a sensor's fit
+// fails its own check, so a failing fit is repeated with the binomial low-pass, and the binomial
+// is kept when its fit has fewer problems.
+std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateOptions& opt,
+                      CalibrateReport* report) {
+  const bool start_binomial = opt.start.sensor[0].antialias_filter != 0;
+  if (std::string e = calibrate_with_filter(sources, opt, report); !e.empty()) return e;
+  if (report->problems.empty() || start_binomial) return {};
+  if (opt.log) {
+    opt.log("the fit with the 2x2 box working image has " +
+            std::to_string(report->problems.size()) +
+            " problem(s): fitting again with the 4x4 binomial (antialias_filter = 1)");
+  }
+  CalibrateOptions binomial = opt;
+  for (auto& c : binomial.start.sensor) c.antialias_filter = 1;
+  CalibrateReport alt;
+  if (std::string e = calibrate_with_filter(sources, binomial, &alt); !e.empty()) return e;
+  const std::size_t box_problems = report->problems.size();
+  if (alt.problems.size() < box_problems) {
+    *report = std::move(alt);
+    report->notes.push_back("antialias_filter 1: the 2x2 box's fit had " +
+                            std::to_string(box_problems) + " problem(s), the binomial's " +
+                            std::to_string(report->problems.size()));
+  } else {
+    report->notes.push_back("antialias_filter 0: the binomial's fit had " +
+                            std::to_string(alt.problems.size()) + " problem(s), no fewer");
+  }
+  return {};
+}
+
 std::string format_report(const CalibrateReport& rep) {
   std::string o;
   char line[512];
@@ -1052,6 +1088,8 @@ std::string format_report(const CalibrateReport& rep) {
                 rep.recordings_per_mode[0], c.c_displacement, rep.recordings_per_mode[1],
                 rep.iterations);
   o += line;
+  o += c.antialias_filter != 0 ? "working image: 4x4 binomial (antialias_filter 1)\n"
+                               : "working image: 2x2 box (antialias_filter 0)\n";
   const auto& p = rep.calibration.paper[0];
   std::snprintf(line, sizeof(line),
                 "rotation scales: joint (%.4g, %.4g, %.4g), displacement proxy ratio "

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 
+#include "tacse3/dsp/luma.hpp"
 #include "tacse3/dsp/types.hpp"
 
 namespace tacse3::dsp {
@@ -39,6 +40,9 @@ struct Calibration {
   // Contact-point geometry (paper Sec. IV-B, κx = 1/pixel_pitch_m, κy = κx/pixel_aspect_y).
   double pixel_pitch_m = 0.075e-3;
   double pixel_aspect_y = 1.0;
+  // The working image's filter (luma.hpp): 0 the 2x2 box, 1 the 4x4 binomial low-pass, for a
+  // pattern finer than four sensor pixels per period. tacse3-calibrate sets it.
+  int antialias_filter = 0;
 
   // Normal response f^z = a_G · (−𝒢) + a_div · div(d).
   double normal_gain_density = 1.0;
@@ -119,5 +123,10 @@ struct Calibration {
 // kOk, or kBadCalibration if any field is NaN/inf, outside its range or breaks a rule of
 // kCalibrationFields / kCalibrationRules (calibration_fields.hpp).
 Status validate(const Calibration& cal) noexcept;
+
+// The working image's filter that cal.antialias_filter names.
+constexpr WorkImageFilter work_image_filter(const Calibration& cal) noexcept {
+  return cal.antialias_filter != 0 ? WorkImageFilter::kBinomial : WorkImageFilter::kBox;
+}
 
 }  // namespace tacse3::dsp

@@ -41,7 +41,7 @@ inline constexpr std::array<VelocityProxyName, 3> kVelocityProxyNames{{
 }};
 
 namespace detail {
-consteval std::array<CalibrationField, 33> make_calibration_fields() {
+consteval std::array<CalibrationField, 34> make_calibration_fields() {
   using F = CalibrationField;
   using C = Calibration;
   return {{
@@ -49,6 +49,9 @@ consteval std::array<CalibrationField, 33> make_calibration_fields() {
        "sensor pixel to metres along x (paper Sec. IV-B, 1/kappa_x)", &C::pixel_pitch_m},
       {"pixel_aspect_y", F::Kind::kReal, 0.25, 4.0, false, false, "1", "pitch_y / pitch_x",
        &C::pixel_aspect_y},
+      {"antialias_filter", F::Kind::kInt, 0, 1, false, false, "-",
+       "working image: 0 the 2x2 box, 1 the 4x4 binomial (a pattern finer than 4 px per period)",
+       nullptr, &C::antialias_filter},
       {"normal_gain_density", F::Kind::kReal, 0.0, 1e4, false, false, "1",
        "f^z per unit of the density proxy -G", &C::normal_gain_density},
       {"normal_gain_divergence", F::Kind::kReal, 0.0, 1e4, false, false, "1",
@@ -121,7 +124,7 @@ consteval std::array<CalibrationField, 33> make_calibration_fields() {
   }};
 }
 }  // namespace detail
-inline constexpr std::array<CalibrationField, 33> kCalibrationFields =
+inline constexpr std::array<CalibrationField, 34> kCalibrationFields =
     detail::make_calibration_fields();
 
 // A rule over two keys: `key` <relation> `other`, shown as

@@ -81,7 +81,8 @@ struct CalibrateReport {
 // that τ; validation runs that also fit the paper fusion's scales and the translation scales; the
 // self-check). Sources must carry truth. Returns an empty string or an error naming the
 // recording when no calibration can be fitted at all; a calibration that was fitted but must not
-// be used comes back with report->problems set.
+// be used comes back with report->problems set. A fit with problems is repeated with the
+// binomial working image (antialias_filter), which is kept if it has fewer problems.
 std::string calibrate(const std::vector<FrameSource*>& sources, const CalibrateOptions& options,
                       CalibrateReport* report);
 
