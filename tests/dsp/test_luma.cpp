@@ -52,6 +52,22 @@ int filtered(int x, int y, Q8 q8) {
   return static_cast<int>((s + 2048) >> 12);
 }
 
+// A YUYV frame whose Y0 of macropixel m on row y is (3m + y) & 0xFF, its Y1 (m + 7y) & 0xFF, and
+// whose chroma bytes are 0xFF and 0, which no working pixel may show.
+std::vector<std::uint8_t> yuyv_ramps() {
+  std::vector<std::uint8_t> f(2 * kSensorWidth * kSensorHeight);
+  for (int y = 0; y < kSensorHeight; ++y) {
+    for (int m = 0; m < kSensorWidth / 2; ++m) {
+      std::uint8_t* p = f.data() + static_cast<std::size_t>(y * 2 * kSensorWidth + 4 * m);
+      p[0] = static_cast<std::uint8_t>((3 * m + y) & 0xFF);  // Y0
+      p[1] = 0xFF;                                           // U (ignored)
+      p[2] = static_cast<std::uint8_t>((m + 7 * y) & 0xFF);  // Y1
+      p[3] = 0x00;                                           // V (ignored)
+    }
+  }
+  return f;
+}
+
 WorkImage sentinel_image() {
   WorkImage img;
   img.px.fill(0xBEEF);
@@ -104,16 +120,7 @@ TEST(Luma, RgbHandComputedBlocks) {
 
 TEST(Luma, YuyvUsesOnlyLumaBytes) {
   // Y0 U Y1 V per macropixel; working pixel x takes Y0, Y1 of macropixel x on two rows.
-  std::vector<std::uint8_t> f(2 * kSensorWidth * kSensorHeight);
-  for (int y = 0; y < kSensorHeight; ++y) {
-    for (int m = 0; m < kSensorWidth / 2; ++m) {
-      std::uint8_t* p = f.data() + static_cast<std::size_t>(y * 2 * kSensorWidth + 4 * m);
-      p[0] = static_cast<std::uint8_t>((3 * m + y) & 0xFF);  // Y0
-      p[1] = 0xFF;                                           // U (ignored)
-      p[2] = static_cast<std::uint8_t>((m + 7 * y) & 0xFF);  // Y1
-      p[3] = 0x00;                                           // V (ignored)
-    }
-  }
+  const std::vector<std::uint8_t> f = yuyv_ramps();
   WorkImage out;
   ASSERT_EQ(frame_to_work_image(frame_view(f, PixelFormat::kYuyv), out), Status::kOk);
   // Hand check at (x, y) = (5, 2): rows 4 and 5, macropixel 5:
@@ -242,16 +249,7 @@ TEST(Luma, EmptyAndSaturatedFrames) {
 
 TEST(LumaBinomial, YuyvUsesOnlyLumaBytes) {
   // Y0 U Y1 V per macropixel: pixel 2m is Y0 of macropixel m, pixel 2m + 1 its Y1.
-  std::vector<std::uint8_t> f(2 * kSensorWidth * kSensorHeight);
-  for (int y = 0; y < kSensorHeight; ++y) {
-    for (int m = 0; m < kSensorWidth / 2; ++m) {
-      std::uint8_t* p = f.data() + static_cast<std::size_t>(y * 2 * kSensorWidth + 4 * m);
-      p[0] = static_cast<std::uint8_t>((3 * m + y) & 0xFF);  // Y0
-      p[1] = 0xFF;                                           // U (ignored)
-      p[2] = static_cast<std::uint8_t>((m + 7 * y) & 0xFF);  // Y1
-      p[3] = 0x00;                                           // V (ignored)
-    }
-  }
+  const std::vector<std::uint8_t> f = yuyv_ramps();
   WorkImage out;
   ASSERT_EQ(frame_to_work_image(frame_view(f, PixelFormat::kYuyv), out, WorkImageFilter::kBinomial),
             Status::kOk);
