@@ -76,7 +76,9 @@ def main():
                               stdout=subprocess.DEVNULL, stderr=log)
     browser = None
     try:
-        wait_for("/api/state", lambda: get_json(base + "/api/state"), 15)
+        # The daemon's start under the sanitizers, beside another test on a loaded machine, once
+        # took over 15 s: the bound only catches a daemon that never serves.
+        wait_for("/api/state", lambda: get_json(base + "/api/state"), 60)
 
         browser = headless_chromium(1400)
         browser.get(base + "/")
@@ -151,6 +153,13 @@ def main():
 
         print(f"screenshot: {args.screenshot}")
         return 0
+    except AssertionError:
+        # What the daemon said (a sanitizer report, a refused port) explains most failures.
+        log.flush()
+        with open(args.screenshot + ".tacse3d.log") as f:
+            print("tacse3d's log:\n" + f.read()[-4000:], file=sys.stderr)
+        print(f"tacse3d exit status: {daemon.poll()}", file=sys.stderr)
+        raise
     finally:
         if browser is not None:
             browser.quit()
