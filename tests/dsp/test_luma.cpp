@@ -155,9 +155,24 @@ TEST(Luma, GreyIsTheExactBlockSum) {
   }
 }
 
-// Fixed point against the double reference on a textured colour frame: the only difference is
-// the single final rounding, so |error| <= 0.5 LSB everywhere and the SNR is that of uniform
-// rounding noise on a ~500-LSB signal (> 60 dB).
+// The fixed-point image against the double reference: only the single final rounding differs,
+// so |error| <= 0.5 LSB everywhere and the SNR is that of uniform rounding noise on a ~500-LSB
+// signal (> 60 dB).
+void expect_rounding_of(const WorkImage& out, const std::vector<double>& ref) {
+  ASSERT_EQ(ref.size(), static_cast<std::size_t>(kWorkPixels));
+  double sig = 0, err = 0, max_err = 0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    const double e = out.px[i] - ref[i];
+    sig += ref[i] * ref[i];
+    err += e * e;
+    max_err = std::max(max_err, std::abs(e));
+  }
+  EXPECT_LE(max_err, 0.5);
+  EXPECT_GE(10.0 * std::log10(sig / err), 60.0);
+}
+
+// Fixed point against the double reference on a textured colour frame (expect_rounding_of),
+// and each pixel by its integer definition.
 TEST(Luma, RgbAgreesWithDoubleReference) {
   const test::DotTexture& tex = texture();
   const auto f = test::render_frame(tex, test::Warp::identity(), PixelFormat::kRgb888);
@@ -165,13 +180,8 @@ TEST(Luma, RgbAgreesWithDoubleReference) {
   ASSERT_EQ(frame_to_work_image(frame_view(f, PixelFormat::kRgb888), out), Status::kOk);
   const std::vector<double> ref =
       dsp_ref::frame_to_work_image_ref(frame_view(f, PixelFormat::kRgb888));
-  ASSERT_EQ(ref.size(), static_cast<std::size_t>(kWorkPixels));
-  double sig = 0, err = 0, max_err = 0;
+  expect_rounding_of(out, ref);
   for (int i = 0; i < kWorkPixels; ++i) {
-    const double e = out.px[static_cast<std::size_t>(i)] - ref[static_cast<std::size_t>(i)];
-    sig += ref[static_cast<std::size_t>(i)] * ref[static_cast<std::size_t>(i)];
-    err += e * e;
-    max_err = std::max(max_err, std::abs(e));
     // Independent integer formula, per pixel.
     const int x = i % kWorkWidth, y = i / kWorkWidth;
     int sr = 0, sg = 0, sb = 0;
@@ -185,8 +195,6 @@ TEST(Luma, RgbAgreesWithDoubleReference) {
     }
     ASSERT_EQ(out.px[static_cast<std::size_t>(i)], (77 * sr + 150 * sg + 29 * sb + 128) >> 8);
   }
-  EXPECT_LE(max_err, 0.5);
-  EXPECT_GE(10.0 * std::log10(sig / err), 60.0);
 }
 
 TEST(Luma, YuyvAndGreyAgreeWithDoubleReferenceExactly) {
@@ -303,9 +311,7 @@ TEST(LumaBinomial, GreyIsTheFilterOfItsBytes) {
   }
 }
 
-// Fixed point against the double reference on a textured colour frame: the only difference is
-// the single final rounding, so |error| <= 0.5 LSB everywhere and the SNR is that of uniform
-// rounding noise on a ~500-LSB signal (> 60 dB).
+// The same for the binomial.
 TEST(LumaBinomial, RgbAgreesWithDoubleReference) {
   const test::DotTexture& tex = texture();
   const auto f = test::render_frame(tex, test::Warp::identity(), PixelFormat::kRgb888);
@@ -320,16 +326,10 @@ TEST(LumaBinomial, RgbAgreesWithDoubleReference) {
     const std::uint8_t* p = f.data() + static_cast<std::size_t>(3 * (j * kSensorWidth + i));
     return 77 * p[0] + 150 * p[1] + 29 * p[2];
   };
-  double sig = 0, err = 0, max_err = 0;
+  expect_rounding_of(out, ref);
   for (int i = 0; i < kWorkPixels; ++i) {
-    const double e = out.px[static_cast<std::size_t>(i)] - ref[static_cast<std::size_t>(i)];
-    sig += ref[static_cast<std::size_t>(i)] * ref[static_cast<std::size_t>(i)];
-    err += e * e;
-    max_err = std::max(max_err, std::abs(e));
     ASSERT_EQ(out.px[static_cast<std::size_t>(i)], filtered(i % kWorkWidth, i / kWorkWidth, q8));
   }
-  EXPECT_LE(max_err, 0.5);
-  EXPECT_GE(10.0 * std::log10(sig / err), 60.0);
 }
 
 // GREY and YUYV: the same single rounding, |error| <= 0.5 LSB.
