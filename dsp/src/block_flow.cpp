@@ -485,6 +485,7 @@ void BlockFlow::tare(const WorkImage& frame) noexcept {
   coarse_pending_ = config_.pyramid_levels > 1;
   has_reference_ = true;
   keyframe_switches_ = 0;
+  coarse_fallback_ = CoarseFallback{};
   frames_since_keyframe_ = 0;
   last_frame_was_keyframe_ = true;
   for (int i = 0; i < kGridCount; ++i) {
@@ -854,14 +855,16 @@ void BlockFlow::upsample_correction(int l) noexcept {
 // window_flow_. Retry pass (after coarse_to_fine()): only the windows that failed, from warm
 // start + the upsampled coarse correction. Then the consensus test over all. Failed points hold
 // their previous window flow. Returns how many trackable windows failed for a reason other than
-// leaving the image (the trigger for the coarse levels).
-int BlockFlow::track_fine(bool retry) noexcept {
+// leaving the image (the trigger for the coarse levels); `fresh` gets how many of those the
+// previous frame had tracked.
+int BlockFlow::track_fine(bool retry, int* fresh) noexcept {
   std::int32_t* fx = flow_x_.data();
   std::int32_t* fy = flow_y_.data();
   std::uint8_t* ok = ok_.data();
   const FlowWindowModel* level0 = level_models(0);
   if (retry) upsample_correction(0);
   int failed = 0;
+  int failed_fresh = 0;  // frame_valid_ still holds the previous frame's until the end
   for (int i = 0; i < kGridCount; ++i) {
     const auto ui = static_cast<std::size_t>(i);
     if (retry && ok[i]) continue;  // keeps its first-pass estimate in fx, fy
@@ -876,6 +879,7 @@ int BlockFlow::track_fine(bool retry) noexcept {
                      clamp_flow(std::int64_t{fy[i]} + cy), config_.fine_iterations);
     if (!r.valid) {
       failed += r.outside ? 0 : 1;
+      failed_fresh += !r.outside && frame_valid_.v[ui] ? 1 : 0;
       continue;
     }
     fx[i] = r.ux;
@@ -886,14 +890,17 @@ int BlockFlow::track_fine(bool retry) noexcept {
   int count = 0;
   for (int i = 0; i < kGridCount; ++i) {
     const auto ui = static_cast<std::size_t>(i);
+    const bool rejected = scratch_[ui] && !ok[i];  // by the consensus test: a failure too
+    failed += rejected ? 1 : 0;
+    failed_fresh += rejected && frame_valid_.v[ui] ? 1 : 0;
     frame_valid_.v[ui] = ok[i];
-    failed += (scratch_[ui] && !ok[i]) ? 1 : 0;  // rejected by the consensus test: a failure too
     if (!ok[i]) continue;
     window_flow_.x.v[ui] = fx[i];
     window_flow_.y.v[ui] = fy[i];
     ++count;
   }
   valid_count_ = count;
+  if (fresh != nullptr) *fresh = failed_fresh;
   return failed;
 }
 
@@ -1194,13 +1201,18 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
   ImagePyramid& cur = pyramid_[static_cast<std::size_t>(cur_index_)];
   build_pyramid(frame, 1, cur);
   coarse_built_ = false;
-  const int failed = track_fine(false);
+  int fresh = 0;
+  const int failed = track_fine(false, &fresh);
+  coarse_fallback_ = CoarseFallback{false, failed, fresh, 0};
   if (config_.pyramid_levels > 1 && failed >= config_.coarse_trigger) {
     build_coarse();
     extend_pyramid(cur, config_.pyramid_levels);
     coarse_built_ = true;
     coarse_to_fine();
+    const int before = valid_count_;
     track_fine(true);
+    coarse_fallback_.ran = true;
+    coarse_fallback_.recovered = valid_count_ - before;
   }
   write_output(displacement, valid);
   ++frames_since_keyframe_;

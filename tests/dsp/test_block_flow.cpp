@@ -185,10 +185,19 @@ TEST(BlockFlow, LargeShiftsRecoveredThroughThePyramid) {
     EXPECT_LE(e.rms, 0.05) << name;
     EXPECT_LE(e.max, 0.25) << name;
     EXPECT_GE(e.valid, trackable_points(w) * 90 / 100) << name;
+    // Level 0 alone lost (nearly) every window; the coarse levels ran and the retry got them.
+    const BlockFlow::CoarseFallback& c = f->last_coarse_fallback();
+    EXPECT_TRUE(c.ran) << name;
+    EXPECT_GE(c.failed, trackable_points(w) * 90 / 100) << name;
+    EXPECT_EQ(c.failed_fresh, c.failed) << name << ": the tare had tracked every window";
+    EXPECT_GE(c.recovered, trackable_points(w) * 80 / 100) << name;
+    EXPECT_LE(c.recovered, e.valid) << name;
     const FlowError flat_e = track_once(*flat, w);
     std::snprintf(name, sizeof name, "jump (%.2f, %.2f), 1 level", s[0], s[1]);
     report(name, flat_e);
     EXPECT_LT(flat_e.valid, trackable_points(w) / 10) << name;
+    EXPECT_FALSE(flat->last_coarse_fallback().ran) << name << ": no coarse level to run";
+    EXPECT_GE(flat->last_coarse_fallback().failed, trackable_points(w) * 90 / 100) << name;
   }
 }
 
@@ -311,9 +320,39 @@ TEST(BlockFlow, WarmStartedSequenceNeedsNoKeyframeForSmallMotion) {
     f->track(test::render_work_image(texture(), w), d, v);
     const FlowError e = error_against(w, d, v);
     ASSERT_LE(e.rms, 0.05) << "frame " << k;
+    // Steady state: level 0 converges from the warm start, the coarse levels stay idle.
+    EXPECT_FALSE(f->last_coarse_fallback().ran) << "frame " << k;
+    EXPECT_LT(f->last_coarse_fallback().failed, BlockFlowConfig{}.coarse_trigger) << "frame " << k;
   }
   EXPECT_EQ(f->keyframe_switches(), 0u);
   EXPECT_EQ(f->frames_since_keyframe(), 8u);
+}
+
+// A region that stops being trackable fails fresh in its first frame and stale after: the
+// fallback's counts tell the two apart (dsp::BlockFlow::CoarseFallback).
+TEST(BlockFlow, AWindowThatKeepsFailingIsCountedFreshOnce) {
+  auto f = make_flow();
+  f->tare(undeformed());
+  VectorField d;
+  GridMask v;
+  std::array<int, 3> failed{}, fresh{};
+  for (int k = 1; k <= 3; ++k) {
+    const Warp w = Warp::shift(0.2 * k, 0.1 * k);
+    WorkImage img = test::render_work_image(texture(), w);
+    if (k >= 2) {  // a flat patch from the second frame on: its windows lose their texture
+      for (int y = 40; y < 80; ++y) {
+        for (int x = 50; x < 100; ++x) img.at(x, y) = 128 << 2;
+      }
+    }
+    f->track(img, d, v);
+    failed[static_cast<std::size_t>(k - 1)] = f->last_coarse_fallback().failed;
+    fresh[static_cast<std::size_t>(k - 1)] = f->last_coarse_fallback().failed_fresh;
+  }
+  EXPECT_LT(failed[0], BlockFlowConfig{}.coarse_trigger) << "the clean frame";
+  EXPECT_GE(failed[1], 10) << "the patch's windows fail";
+  EXPECT_EQ(fresh[1], failed[1]) << "all of them tracked in the frame before";
+  EXPECT_GE(failed[2], failed[1] * 9 / 10) << "and keep failing";
+  EXPECT_LE(fresh[2], failed[2] / 10) << "now stale, not fresh";
 }
 
 // The coarse levels run on demand (coarse_trigger failures at level 0). Forcing them on every

@@ -152,6 +152,17 @@ class BlockFlow {
   bool deferred_pending() const noexcept { return deferred_pending_; }
 
   bool has_reference() const noexcept { return has_reference_; }
+  // The last track()'s coarse fallback: whether the coarse levels ran, how many windows failed
+  // at level 0 from their warm start (the trigger's count), how many of those the frame before
+  // had tracked, and how many more windows the frame tracked after the retry than before it
+  // (net: the retry's consensus may also drop some).
+  struct CoarseFallback {
+    bool ran = false;
+    int failed = 0;
+    int failed_fresh = 0;
+    int recovered = 0;
+  };
+  const CoarseFallback& last_coarse_fallback() const noexcept { return coarse_fallback_; }
   std::uint32_t keyframe_switches() const noexcept { return keyframe_switches_; }  // since tare
   std::uint32_t frames_since_keyframe() const noexcept { return frames_since_keyframe_; }
   bool last_frame_was_keyframe() const noexcept { return last_frame_was_keyframe_; }
@@ -238,7 +249,7 @@ class BlockFlow {
   void switch_keyframe() noexcept;
   void re_anchor() noexcept;
   void upsample_correction(int level) noexcept;
-  int track_fine(bool retry) noexcept;
+  int track_fine(bool retry, int* fresh = nullptr) noexcept;
   bool fit_from_neighbours(int gx, int gy, std::int32_t& ux, std::int32_t& uy) const noexcept;
 
   BlockFlowConfig config_{};
@@ -247,6 +258,7 @@ class BlockFlow {
   int key_index_ = 2;  // pyramid_ slot of the keyframe (2 = the tare frame itself)
   int cur_index_ = 0;  // pyramid_ slot that receives new frames (0 or 1, never the keyframe)
   std::uint32_t keyframe_switches_ = 0;
+  CoarseFallback coarse_fallback_{};
   std::uint32_t frames_since_keyframe_ = 0;
   bool last_frame_was_keyframe_ = false;
   bool deferred_pending_ = false;    // the last track()'s run_deferred() has not run yet
