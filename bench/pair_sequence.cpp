@@ -76,6 +76,8 @@ const char* event_name(unsigned event) noexcept {
       return "tare";
     case kLostPad:
       return "lost pad";
+    case kCoarseFallback:
+      return "coarse fallback";
     default:
       return "?";
   }
@@ -166,6 +168,17 @@ PairTimes run_pair_sequence(const PairSequence& seq) {
     if (out.sensors[0].keyframe_switched || out.sensors[1].keyframe_switched) {
       events |= kKeyframeSwitch;
     }
+    for (std::size_t k = 0; k < 2; ++k) {
+      if (pair.pad[k].empty()) continue;
+      const auto& c = p->sensor(static_cast<dsp::SensorSlot>(k)).flow().last_coarse_fallback();
+      ++t.pad_frames;
+      if (!c.ran) continue;
+      events |= kCoarseFallback;
+      ++t.coarse_runs;
+      t.coarse_failed += c.failed;
+      t.coarse_failed_fresh += c.failed_fresh;
+      t.coarse_recovered += c.recovered;
+    }
     t.events.push_back(events);
     t_ns += kPeriodNs;
   }
@@ -202,6 +215,14 @@ void report_pair_times(const PairTimes& times, benchmark::State& state) {
     std::replace(key.begin(), key.end(), ' ', '_');
     state.counters[key + "_max_us"] = event_max[static_cast<std::size_t>(b)];
   }
+  state.counters["coarse_share"] = static_cast<double>(times.coarse_runs) /
+                                   static_cast<double>(std::max<std::size_t>(times.pad_frames, 1));
+  state.counters["coarse_fresh_failures"] =
+      static_cast<double>(times.coarse_failed_fresh) /
+      static_cast<double>(std::max<long>(times.coarse_failed, 1));
+  state.counters["coarse_recovered_per_run"] =
+      static_cast<double>(times.coarse_recovered) /
+      static_cast<double>(std::max<std::size_t>(times.coarse_runs, 1));
   state.SetLabel("max: pair " + std::to_string(slowest) + " (" +
                  event_names(times.events[slowest]) + ")");
 }

@@ -19,8 +19,9 @@ enum PairEvent : unsigned {
   kRelease = 1u << 2,         // either pad's true contact ended
   kTare = 1u << 3,            // a tare was requested just before the pair, or it is the next
   kLostPad = 1u << 4,         // one pad's frame is missing, or is back after missing
+  kCoarseFallback = 1u << 5,  // either pad's block flow ran its coarse levels
 };
-inline constexpr int kPairEventCount = 5;
+inline constexpr int kPairEventCount = 6;
 const char* event_name(unsigned event) noexcept;
 std::string event_names(unsigned events);  // "keyframe switch+onset", or "none"
 
@@ -46,13 +47,24 @@ struct PairTimes {
   // each pad's thread once the frame is handed on: off the latency, not off the CPU budget.
   std::vector<double> deferred_us;
   std::vector<unsigned> events;
+  // Pad frames tracked, those whose block flow ran its coarse levels, the level-0 failures that
+  // triggered those runs (and of them, the windows the frame before had tracked), and the
+  // windows the runs recovered (dsp::BlockFlow::last_coarse_fallback()).
+  std::size_t pad_frames = 0;
+  std::size_t coarse_runs = 0;
+  long coarse_failed = 0;
+  long coarse_failed_fresh = 0;
+  long coarse_recovered = 0;
 };
 
 PairTimes run_pair_sequence(const PairSequence& seq);
 
 // Counters p50_us, p99_us, max_us and the largest pair of each event (<event>_max_us), of the
 // frames-to-result time; deferred_max_us, and cycle_p50_us / cycle_max_us of the whole cycle's
-// CPU time (result + deferred). The label names the slowest pair and its events.
+// CPU time (result + deferred); coarse_share, the share of pad frames whose block flow ran its
+// coarse levels, coarse_fresh_failures, the share of the failures behind those runs that the
+// frame before had tracked, and coarse_recovered_per_run, the windows a run recovered on average.
+// The label names the slowest pair and its events.
 void report_pair_times(const PairTimes& times, benchmark::State& state);
 
 }  // namespace tacse3::bench
