@@ -35,6 +35,16 @@ check "replay CSV rows = frames" test "$(($(wc -l < "$T/out.csv") - 1))" -eq "$f
 check "replay summary has the rotation" contains "$T/stdout" "rotation: *estimated"
 check "replay summary has the truth" contains "$T/stdout" "truth *2.00 deg"
 check "a full truth gives no truth warning" lacks "$T/stdout" "truth.csv ends at"
+check "a run with valid frames gives no all-invalid warning" lacks "$T/stdout" "no frame gave"
+
+# A contact threshold no f^z reaches: no frame is valid, and the summary says what to check.
+printf 'format = "tacse3-calibration"\nversion = 1\n\n[sensor]\ncontact_tau_on = 100\ncontact_tau_off = 50\n' \
+  > "$T/deaf.toml"
+"$REPLAY" "$T/rec" --calibration "$T/deaf.toml" --out "$T/x.csv" > "$T/stdout_d" 2> /dev/null
+check "replay with no valid frame exits 0" test $? -eq 0
+check "it reads no valid frame" contains "$T/stdout_d" "estimate valid in 0% of frames"
+check "and warns, naming the threshold" contains "$T/stdout_d" \
+  "warning: no frame gave a valid estimate.*contact_tau_on 100 may be above"
 
 # A truth.csv that ends before the last frame: the summary warns, naming the file and its end.
 cp -r "$T/rec" "$T/rect"

@@ -324,6 +324,17 @@ int run(int argc, char** argv) {
                (cal_text + (opt.calibration.fitted ? "" : ": UNCALIBRATED")).c_str());
   std::fprintf(report, "  estimate valid in %.0f%% of frames; wrote %s\n",
                100.0 * sum.valid_fraction, to_stdout ? "standard output" : out_file.c_str());
+  if (sum.valid_fraction <= 0.0 && !run.frames.empty()) {
+    // An all-invalid run is almost always a setup problem, not a still object: say what to check.
+    const double tau = opt.calibration.sensor[0].contact_tau_on;
+    std::fprintf(report,
+                 "  warning: no frame gave a valid estimate, so no pad saw a contact it could "
+                 "read. Check that the pads touch the object; that the calibration is this "
+                 "sensor's (its contact_tau_on %.4g may be above this sensor's f^z: "
+                 "docs/calibration.md); and that the object's face does not cover the pad's "
+                 "whole view (docs/accuracy.md, \"Other known limits\")\n",
+                 tau);
+  }
   std::fprintf(report, "  confidence >= %.1f in %.0f%% of frames (median %.2f where valid)\n",
                tacse3::dsp::kConfidenceThreshold, 100.0 * sum.confident_fraction,
                sum.confidence_median);
