@@ -178,6 +178,7 @@ PairTimes run_pair_sequence(const PairSequence& seq) {
       t.coarse_failed += c.failed;
       t.coarse_failed_fresh += c.failed_fresh;
       t.coarse_recovered += c.recovered;
+      t.coarse_windows += c.coarse_windows;
     }
     t.events.push_back(events);
     t_ns += kPeriodNs;
@@ -222,6 +223,9 @@ void report_pair_times(const PairTimes& times, benchmark::State& state) {
       static_cast<double>(std::max<long>(times.coarse_failed, 1));
   state.counters["coarse_recovered_per_run"] =
       static_cast<double>(times.coarse_recovered) /
+      static_cast<double>(std::max<std::size_t>(times.coarse_runs, 1));
+  state.counters["coarse_windows_per_run"] =
+      static_cast<double>(times.coarse_windows) /
       static_cast<double>(std::max<std::size_t>(times.coarse_runs, 1));
   state.SetLabel("max: pair " + std::to_string(slowest) + " (" +
                  event_names(times.events[slowest]) + ")");

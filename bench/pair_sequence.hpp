@@ -49,12 +49,14 @@ struct PairTimes {
   std::vector<unsigned> events;
   // Pad frames tracked, those whose block flow ran its coarse levels, the level-0 failures that
   // triggered those runs (and of them, the windows the frame before had tracked), and the
-  // windows the runs recovered (dsp::BlockFlow::last_coarse_fallback()).
+  // windows the runs recovered and the coarse windows they tracked
+  // (dsp::BlockFlow::last_coarse_fallback()).
   std::size_t pad_frames = 0;
   std::size_t coarse_runs = 0;
   long coarse_failed = 0;
   long coarse_failed_fresh = 0;
   long coarse_recovered = 0;
+  long coarse_windows = 0;
 };
 
 PairTimes run_pair_sequence(const PairSequence& seq);
@@ -63,8 +65,9 @@ PairTimes run_pair_sequence(const PairSequence& seq);
 // frames-to-result time; deferred_max_us, and cycle_p50_us / cycle_max_us of the whole cycle's
 // CPU time (result + deferred); coarse_share, the share of pad frames whose block flow ran its
 // coarse levels, coarse_fresh_failures, the share of the failures behind those runs that the
-// frame before had tracked, and coarse_recovered_per_run, the windows a run recovered on average.
-// The label names the slowest pair and its events.
+// frame before had tracked, coarse_recovered_per_run, the windows a run recovered on average, and
+// coarse_windows_per_run, the coarse windows it tracked on average (of 370). The label names the
+// slowest pair and its events.
 void report_pair_times(const PairTimes& times, benchmark::State& state);
 
 }  // namespace tacse3::bench

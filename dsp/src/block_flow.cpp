@@ -167,14 +167,6 @@ inline std::int32_t residual_energy(const std::int16_t* __restrict res) noexcept
   return s;
 }
 
-// Cell-centred 2x upsampling index pair of fine index k on a coarse axis of n samples:
-// weight 3/4 on `near`, 1/4 on `far`.
-void upsample_taps(int k, int n, int& near, int& far) noexcept {
-  const int m = k >> 1;
-  near = std::min(m, n - 1);
-  far = std::clamp((k & 1) ? m + 1 : m - 1, 0, n - 1);
-}
-
 // Q16 reciprocals 1/d for the small integer window spacings used by the output correction.
 constexpr int kMinSpacing = 3;
 constexpr int kMaxSpacing = 32;
@@ -749,6 +741,13 @@ BlockFlow::WindowResult BlockFlow::track_window(int level, int index, std::int32
 
 void BlockFlow::coarse_to_fine() noexcept {
   const int levels = config_.pyramid_levels;
+  // Only the coarse windows the retry of the failed level-0 windows draws on (CoarseRegion).
+  const FlowWindowModel* level0 = level_models(0);
+  for (int i = 0; i < kGridCount; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    retry_[u] = static_cast<std::uint8_t>(level0[u].valid && !ok_[u]);
+  }
+  coarse_region_.build(retry_.data(), levels);
   // Warm starts of the coarse grids: block means of the level-0 window flow (Q16 working px).
   for (int l = 1; l < levels; ++l) {
     const int gw = flow_grid_width(l);
@@ -790,7 +789,7 @@ void BlockFlow::coarse_to_fine() noexcept {
         fx[j] = clamp_flow(std::int64_t{warm_x_[i]} + up_x_[i]);
         fy[j] = clamp_flow(std::int64_t{warm_y_[i]} + up_y_[i]);
         ok[j] = 0;
-        if (!models_[i].valid) continue;
+        if (!models_[i].valid || !coarse_region_.tracked(l, j)) continue;
         const WindowResult r = track_window(l, j, static_cast<std::int32_t>(rshift_round(fx[j], l)),
                                             static_cast<std::int32_t>(rshift_round(fy[j], l)),
                                             config_.coarse_iterations);
@@ -1203,7 +1202,7 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
   coarse_built_ = false;
   int fresh = 0;
   const int failed = track_fine(false, &fresh);
-  coarse_fallback_ = CoarseFallback{false, failed, fresh, 0};
+  coarse_fallback_ = CoarseFallback{false, failed, fresh, 0, 0};
   if (config_.pyramid_levels > 1 && failed >= config_.coarse_trigger) {
     build_coarse();
     extend_pyramid(cur, config_.pyramid_levels);
@@ -1213,6 +1212,7 @@ void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMas
     track_fine(true);
     coarse_fallback_.ran = true;
     coarse_fallback_.recovered = valid_count_ - before;
+    coarse_fallback_.coarse_windows = coarse_region_.tracked_count();
   }
   write_output(displacement, valid);
   ++frames_since_keyframe_;

@@ -201,6 +201,32 @@ TEST(BlockFlow, LargeShiftsRecoveredThroughThePyramid) {
   }
 }
 
+// A jump confined to one patch: the coarse fallback tracks only the coarse windows that the
+// failed windows draw on (dsp::CoarseRegion), and the retry recovers them all the same.
+TEST(BlockFlow, ALocalJumpIsRecoveredByALocalCoarsePass) {
+  auto f = make_flow();
+  // A Gaussian bump of 8 sensor px (4 working px, beyond level 0's reach) at (100, 80), sigma
+  // 24 px: its largest strain (0.2) keeps the warp invertible.
+  const Warp w = Warp::displacement([](double x, double y) {
+    const double dx = x - 100.0, dy = y - 80.0;
+    const double a = 8.0 * std::exp(-(dx * dx + dy * dy) / (2 * 24.0 * 24.0));
+    return Vec2{a, -0.5 * a};
+  });
+  const FlowError e = track_once(*f, w);
+  report("local bump of 4 working px", e);
+  EXPECT_LE(e.rms, 0.05);
+  EXPECT_GE(e.valid, trackable_points(w) * 95 / 100);
+  const BlockFlow::CoarseFallback& c = f->last_coarse_fallback();
+  std::printf("  coarse pass: %d failed, %d recovered, %d coarse windows tracked\n", c.failed,
+              c.recovered, c.coarse_windows);
+  ASSERT_TRUE(c.ran);
+  EXPECT_GE(c.failed, 10) << "the bump is beyond level 0's reach";
+  EXPECT_GE(c.recovered, c.failed * 8 / 10);
+  EXPECT_GT(c.coarse_windows, 0);
+  EXPECT_LT(c.coarse_windows, (flow_grid_count(1) + flow_grid_count(2)) / 2)
+      << "most of the grid did not move: its coarse windows are not needed";
+}
+
 // --- Sequences: warm start, keyframe chaining, tare ----------------------------------------
 
 // A contact-like deformation: a Gaussian shear bump plus a small rotation, expansion and

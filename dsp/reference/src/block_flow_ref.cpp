@@ -5,7 +5,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
+#include "tacse3/dsp/coarse_region.hpp"
 #include "tacse3/dsp/geometry.hpp"
 #include "tacse3/dsp/pyramid.hpp"
 
@@ -400,9 +402,18 @@ bool BlockFlowRef::fit_from_neighbours(int gx, int gy, double& ux, double& uy) c
 }
 
 // Warm starts (block means of the level-0 window flow) and the coarse levels, top down, as in
-// dsp::BlockFlow::coarse_to_fine(). Leaves the level-1 correction in cx_[1], cy_[1].
-void BlockFlowRef::coarse_levels() {
+// dsp::BlockFlow::coarse_to_fine(): only the coarse windows that the retried level-0 windows
+// draw on are tracked (dsp::CoarseRegion). Leaves the level-1 correction in cx_[1], cy_[1].
+void BlockFlowRef::coarse_levels(const dsp::GridMask* follow_valid) {
   const int levels = cfg_.pyramid_levels;
+  std::vector<std::uint8_t> retry(static_cast<std::size_t>(dsp::kGridCount), 0);
+  for (std::size_t i = 0; i < retry.size(); ++i) {
+    const WindowRef& m = models_[0][i];
+    const bool followed = follow_valid != nullptr && follow_valid->v[i] != 0 && m.solvable;
+    retry[i] = static_cast<std::uint8_t>(!ok_[i] && (m.valid || followed));
+  }
+  auto region = std::make_unique<dsp::CoarseRegion>();
+  region->build(retry.data(), levels);
   std::vector<std::vector<double>>& cx = cx_;
   std::vector<std::vector<double>>& cy = cy_;
   cx.assign(static_cast<std::size_t>(levels), {});
@@ -463,7 +474,7 @@ void BlockFlowRef::coarse_levels() {
         fx[i] = wx[ls][i] + ux;
         fy[i] = wy[ls][i] + uy;
         const WindowRef& m = models_[ls][i];
-        if (!m.valid) continue;
+        if (!m.valid || !region->tracked(l, static_cast<int>(i))) continue;
         const Result r = track_window(l, m, fx[i] / scale, fy[i] / scale, cfg_.coarse_iterations);
         if (!r.valid) continue;
         fx[i] = r.ux * scale;
@@ -705,7 +716,7 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
   }
   int failed = track_fine(false, follow_valid);
   if (cfg_.pyramid_levels > 1 && failed >= cfg_.coarse_trigger) {
-    coarse_levels();
+    coarse_levels(follow_valid);
     track_fine(true, follow_valid);
   }
   if (follow_valid != nullptr) follow_validity(*follow_valid, held_x, held_y);

@@ -6,33 +6,12 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "tacse3/dsp/coarse_region.hpp"
+#include "tacse3/dsp/flow_grid.hpp"
 #include "tacse3/dsp/pyramid.hpp"
 #include "tacse3/dsp/types.hpp"
 
 namespace tacse3::dsp {
-
-// Square matching window, in pixels of the pyramid level it is applied to. 8 x 8 working px
-// (16 x 16 sensor px) centred on a grid point: neighbouring windows overlap by half.
-inline constexpr int kFlowWindow = 8;
-inline constexpr int kFlowWindowPixels = kFlowWindow * kFlowWindow;  // 64 = 2^6
-
-// Grid of level l: the level-0 grid decimated by 2^l. Point j of level l sits at level-l
-// coordinate 4 j + 1.5 and stands for the 2^l x 2^l block of level-0 points it covers.
-constexpr int flow_grid_width(int level) noexcept {
-  return kGridWidth >> level;
-}
-constexpr int flow_grid_height(int level) noexcept {
-  return kGridHeight >> level;
-}
-constexpr int flow_grid_count(int level) noexcept {
-  return flow_grid_width(level) * flow_grid_height(level);
-}
-constexpr int flow_grid_offset(int level) noexcept {
-  int off = 0;
-  for (int l = 0; l < level; ++l) off += flow_grid_count(l);
-  return off;
-}
-inline constexpr int kFlowModelCount = flow_grid_offset(kMaxPyramidLevels);  // 1200+300+70
 
 // Tuning of the block flow. Lengths are in pixels of the pyramid level they act on unless
 // they say "working px" (level 0). Converted to integers once, in configure().
@@ -155,12 +134,14 @@ class BlockFlow {
   // The last track()'s coarse fallback: whether the coarse levels ran, how many windows failed
   // at level 0 from their warm start (the trigger's count), how many of those the frame before
   // had tracked, and how many more windows the frame tracked after the retry than before it
-  // (net: the retry's consensus may also drop some).
+  // (net: the retry's consensus may also drop some), and how many coarse windows it tracked
+  // (CoarseRegion: those the retried windows draw on).
   struct CoarseFallback {
     bool ran = false;
     int failed = 0;
     int failed_fresh = 0;
     int recovered = 0;
+    int coarse_windows = 0;
   };
   const CoarseFallback& last_coarse_fallback() const noexcept { return coarse_fallback_; }
   std::uint32_t keyframe_switches() const noexcept { return keyframe_switches_; }  // since tare
@@ -318,6 +299,9 @@ class BlockFlow {
   std::array<std::int32_t, kFlowModelCount> flow_y_{};
   std::array<std::uint8_t, kFlowModelCount> ok_{};
   std::array<std::uint8_t, kFlowModelCount> scratch_{};
+  // The coarse fallback's level-0 windows to retry and the coarse windows they draw on.
+  std::array<std::uint8_t, kGridCount> retry_{};
+  CoarseRegion coarse_region_{};
 };
 
 }  // namespace tacse3::dsp

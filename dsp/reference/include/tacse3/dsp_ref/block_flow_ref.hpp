@@ -110,7 +110,7 @@ class BlockFlowRef {
   };
   void take_keyframe();
   void build_level(int level);
-  void coarse_levels();
+  void coarse_levels(const dsp::GridMask* follow_valid);
   void coarse_correction(int level, int jx, int jy, double& ox, double& oy) const;
   // follow_valid (decision-locked track() only): also track the windows the fixed-point path
   // tracked whose model failed only a texture test here.
