@@ -452,15 +452,25 @@ Status BlockFlow::configure(const BlockFlowConfig& config) noexcept {
   th_.keyframe_min_valid_q16 =
       static_cast<std::int64_t>(config.keyframe_min_valid_fraction * 65536.0 + 0.5);
   has_reference_ = false;
+  reference_pending_ = false;
   deferred_pending_ = false;  // a switch decided under the old config is dropped with the reference
   return Status::kOk;
 }
 
 void BlockFlow::tare(const WorkImage& frame) noexcept {
+  if (reference_pending_) {  // a first frame still to become the reference: this one replaces it
+    reference_pending_ = false;
+    deferred_pending_ = false;
+  }
   run_deferred();  // the state a tare leaves is then that of every earlier frame's work done
   // The tare frame keeps its own pyramid slot and its own level-0 window models for the whole
   // session (re-anchoring, see re_anchor()).
   build_pyramid(frame, config_.pyramid_levels, pyramid_[kTareSlot]);
+  take_reference();
+}
+
+// The frame in the tare slot's pyramid (every level) becomes the reference and the keyframe.
+void BlockFlow::take_reference() noexcept {
   key_index_ = static_cast<int>(kTareSlot);
   key_coarse_pyramid_ = true;
   cur_index_ = 0;
@@ -1077,6 +1087,12 @@ void BlockFlow::switch_keyframe() noexcept {
 void BlockFlow::run_deferred() noexcept {
   if (!deferred_pending_) return;
   deferred_pending_ = false;
+  if (reference_pending_) {
+    reference_pending_ = false;
+    extend_pyramid(pyramid_[kTareSlot], config_.pyramid_levels);
+    take_reference();
+    return;
+  }
   if (last_frame_was_keyframe_) {
     switch_keyframe();
     build_level0();  // the next track() matches against it
@@ -1186,9 +1202,18 @@ bool BlockFlow::fit_from_neighbours(int gx, int gy, std::int32_t& ux,
 
 void BlockFlow::track(const WorkImage& frame, VectorField& displacement, GridMask& valid) noexcept {
   if (!has_reference_) {
-    tare(frame);
-    displacement = output_;
-    valid = frame_valid_;
+    // The first frame becomes the reference as a tare's frame does, in the deferred work: its
+    // window models cost about as much as tracking a frame. Nothing is tracked in it.
+    build_pyramid(frame, 1, pyramid_[kTareSlot]);
+    has_reference_ = true;
+    reference_pending_ = true;
+    deferred_pending_ = true;
+    last_frame_was_keyframe_ = true;
+    keyframe_switches_ = 0;
+    coarse_fallback_ = CoarseFallback{};
+    valid_count_ = 0;
+    displacement = VectorField{};
+    valid = GridMask{};
     return;
   }
   // Level 0 from the warm start first. The coarse levels (pyramid, coarse tracking, retry of the

@@ -56,7 +56,6 @@ Status SensorPipeline::configure(const PipelineConfig& config, const Calibration
   image_filter_ = work_image_filter(cal);
   min_tracked_points_ =
       static_cast<int>(std::ceil(config.min_tracked_fraction * static_cast<double>(kGridCount)));
-  tare_pending_ = true;
   nhhd_.reset();
   contact_.reset();
   motion_.reset();
@@ -76,7 +75,7 @@ Status SensorPipeline::set_image_calibration(const Calibration& cal) noexcept {
     // Another filter gives another image: the reference and the keyframes no longer match it,
     // so the next frame becomes the reference.
     image_filter_ = work_image_filter(cal);
-    tare_pending_ = true;
+    flow_.drop_reference();
     nhhd_.reset();
     contact_.reset();
   }
@@ -96,14 +95,9 @@ void SensorPipeline::tare() noexcept {
 }
 
 void SensorPipeline::tare_image() noexcept {
-  if (flow_.has_reference()) {
-    // The last processed frame is still in fields_.work: it becomes the reference now, so the
-    // very next frame already measures against it.
-    flow_.tare(fields_.work);
-    tare_pending_ = false;
-  } else {
-    tare_pending_ = true;
-  }
+  // The last processed frame is still in fields_.work: it becomes the reference now, so the
+  // very next frame already measures against it. Before any frame, the first frame becomes it.
+  if (flow_.has_reference()) flow_.tare(fields_.work);
   nhhd_.reset();
   contact_.reset();
 }
@@ -135,12 +129,9 @@ void SensorPipeline::process_image(const FrameView& frame, PadStages& stages) no
   }
   (void)frame_to_work_image(frame, fields_.work, image_filter_);
 
-  // Stage 2: block flow against the adaptive reference, Eq. (dense_flow).
-  if (tare_pending_) {
-    flow_.tare(fields_.work);
-    tare_pending_ = false;
-    out.reference_taken = true;
-  }
+  // Stage 2: block flow against the adaptive reference, Eq. (dense_flow). Without one, this frame
+  // becomes it (in the deferred work) and tracks nothing: that is not a degraded frame.
+  out.reference_taken = !flow_.has_reference();
   flow_.track(fields_.work, fields_.flow, fields_.flow_valid);
   out.tracked_points = flow_.valid_count();
   out.keyframe_switches = flow_.keyframe_switches();
@@ -161,7 +152,7 @@ void SensorPipeline::process_image(const FrameView& frame, PadStages& stages) no
   contact_.detect(fields_.fz, fields_.smoothed, fields_.smoothed_valid, fields_.contact);
 
   out.processed = true;
-  out.degraded = out.tracked_points < min_tracked_points_;
+  out.degraded = !out.reference_taken && out.tracked_points < min_tracked_points_;
   stages.contact = fields_.contact;
   stages.shear = fields_.shear;
 }

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <tuple>
 #include <vector>
 
 #include "support/synthetic.hpp"
@@ -439,23 +440,70 @@ TEST(BlockFlow, TareResetsTheReference) {
   EXPECT_NEAR(d.y(20, 15) / kQ16, -0.25, 0.05);
 }
 
-TEST(BlockFlow, FirstCallIsAnImplicitTare) {
+// The first frame becomes the reference in the deferred work, as a tare's frame does: it reports
+// zeros and no valid point, and the reference it leaves is the one tare() builds from it.
+TEST(BlockFlow, FirstCallIsAnImplicitTareDeferred) {
   auto f = make_flow();
   EXPECT_FALSE(f->has_reference());
   VectorField d;
   d.x.fill(123);
   GridMask v;
+  v.v.fill(1);
   f->track(undeformed(), d, v);
   EXPECT_TRUE(f->has_reference());
-  int valid = 0;
+  EXPECT_TRUE(f->deferred_pending()) << "the models are built after the frame";
+  EXPECT_TRUE(f->last_frame_was_keyframe());
   for (int i = 0; i < kGridCount; ++i) {
     ASSERT_EQ(d.x.v[static_cast<std::size_t>(i)], 0);
-    valid += v.v[static_cast<std::size_t>(i)];
+    ASSERT_EQ(v.v[static_cast<std::size_t>(i)], 0);
   }
-  // valid = the windows trackable in that frame: nearly all of a random-dot texture (a few
-  // windows fall in a gap between dots and fail the texture test).
-  EXPECT_EQ(valid, f->keyframe_valid_count());
-  EXPECT_GE(valid, kGridCount * 99 / 100);
+  EXPECT_EQ(f->valid_count(), 0);
+  f->run_deferred();
+  auto tared = make_flow();
+  tared->tare(undeformed());
+  f->complete_keyframe();
+  tared->complete_keyframe();
+  // Nearly every window of a random-dot texture is trackable (a few fall in a gap between dots).
+  EXPECT_GE(f->keyframe_valid_count(), kGridCount * 99 / 100);
+  EXPECT_EQ(f->keyframe_valid_count(), tared->keyframe_valid_count());
+  for (int l = 0; l < BlockFlowConfig{}.pyramid_levels; ++l) {
+    for (int i = 0; i < flow_grid_count(l); ++i) {
+      const FlowWindowModel& a = f->window_model(l, i);
+      const FlowWindowModel& b = tared->window_model(l, i);
+      const auto key = [](const FlowWindowModel& m) {
+        return std::make_tuple(m.valid, m.ox, m.oy, m.shift, m.inv_a, m.inv_b, m.inv_c, m.gsum_x,
+                               m.gsum_y, m.tsum, m.gain_qx, m.gain_qy, m.template_energy,
+                               m.curvature, m.moment_x, m.moment_y);
+      };
+      ASSERT_EQ(key(a), key(b)) << "level " << l << " window " << i;
+    }
+  }
+  // The next frame is measured against it.
+  const Warp w = Warp::shift(1.0, -0.6);
+  f->track(test::render_work_image(texture(), w), d, v);
+  EXPECT_LE(error_against(w, d, v).rms, 0.05);
+  EXPECT_GE(error_against(w, d, v).valid, trackable_points(w) * 95 / 100);
+}
+
+// A tare while the first frame's reference is still pending replaces it; a frame tracked before
+// the deferred work ran builds it first.
+TEST(BlockFlow, APendingFirstReferenceIsReplacedByATareOrBuiltByTheNextFrame) {
+  const Warp moved = Warp::shift(3.0, 2.0);
+  const WorkImage moved_img = test::render_work_image(texture(), moved);
+  VectorField d;
+  GridMask v;
+  auto f = make_flow();
+  f->track(moved_img, d, v);
+  f->tare(undeformed());  // the reference is the undeformed frame, not the moved one
+  f->track(moved_img, d, v);
+  EXPECT_LE(error_against(moved, d, v).rms, 0.05);
+  EXPECT_GE(error_against(moved, d, v).valid, trackable_points(moved) * 95 / 100);
+
+  auto g = make_flow();
+  g->track(undeformed(), d, v);
+  g->track(moved_img, d, v);  // no run_deferred() in between
+  EXPECT_LE(error_against(moved, d, v).rms, 0.05);
+  EXPECT_GE(error_against(moved, d, v).valid, trackable_points(moved) * 95 / 100);
 }
 
 // --- Bad frames -----------------------------------------------------------------------------

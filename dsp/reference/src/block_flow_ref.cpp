@@ -700,11 +700,11 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
                          std::vector<double>& dy, std::vector<std::uint8_t>& valid,
                          const FlowDecision* follow) {
   const auto n = static_cast<std::size_t>(dsp::kGridCount);
-  if (!has_reference_) {
+  if (!has_reference_) {  // the implicit tare: nothing tracked (dsp::BlockFlow::track())
     tare(frame);
     dx.assign(n, 0.0);
     dy.assign(n, 0.0);
-    valid = valid_;
+    valid.assign(n, 0);
     return;
   }
   cur_ = build_pyramid_ref(frame, cfg_.pyramid_levels);

@@ -25,12 +25,7 @@ SensorPipelineRef::SensorPipelineRef(const dsp::PipelineConfig& config, const ds
 }
 
 void SensorPipelineRef::tare() {
-  if (flow_stage_.has_reference()) {
-    flow_stage_.tare(last_work_);
-    tare_pending_ = false;
-  } else {
-    tare_pending_ = true;
-  }
+  if (flow_stage_.has_reference()) flow_stage_.tare(last_work_);  // else the next frame's own
   nhhd_stage_.reset();
   contact_stage_.reset();
   motion_stage_.reset();
@@ -45,10 +40,7 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
   // reference starts from the same working image.
   if (dsp::frame_to_work_image(frame, last_work_, dsp::work_image_filter(cal_)) != dsp::Status::kOk)
     return false;
-  if (tare_pending_) {
-    flow_stage_.tare(last_work_);
-    tare_pending_ = false;
-  }
+  const bool reference = !flow_stage_.has_reference();  // this frame becomes it: not degraded
   std::vector<std::uint8_t> valid;
   flow_stage_.track(last_work_, flow_.x, flow_.y, valid,
                     follow != nullptr ? &follow->flow : nullptr);
@@ -78,7 +70,7 @@ bool SensorPipelineRef::process(const dsp::FrameView& frame, double dt_s, Sensor
 
   const int min_tracked = static_cast<int>(
       std::ceil(config_.min_tracked_fraction * static_cast<double>(dsp::kGridCount)));
-  if (tracked < min_tracked) {
+  if (!reference && tracked < min_tracked) {
     degraded = true;
     motion_stage_.reset();
     return true;

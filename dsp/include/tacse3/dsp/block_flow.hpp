@@ -119,18 +119,27 @@ class BlockFlow {
   // tare frame, Q16 working px. `valid`: 1 where the point was tracked in this frame (window
   // inside the image, well-conditioned, converged, small residual, consistent with its
   // neighbours). Invalid points hold their previous displacement. The first call without a
-  // reference is an implicit tare (all zeros; valid = the points trackable in that frame).
-  // A keyframe switch is decided here (last_frame_was_keyframe()), but its work, which only
-  // the next frame needs, is left to run_deferred(); track() and tare() run it first if the
-  // caller has not, so no result depends on when it runs.
+  // reference is an implicit tare (all zeros, no point valid): the frame becomes the reference
+  // in run_deferred(), as a tare's would. A keyframe switch is decided here
+  // (last_frame_was_keyframe()), but its work, which only the next frame needs, is left to
+  // run_deferred() too; track() and tare() run it first if the caller has not, so no result
+  // depends on when it runs.
   void track(const WorkImage& frame, VectorField& displacement, GridMask& valid) noexcept;
-  // The last track()'s deferred work: a keyframe switch (neighbour fit, re-anchoring) and the
-  // new keyframe's level-0 models, or a pending coarse-level build. For a caller with spare
+  // The last track()'s deferred work: the first frame's reference (its pyramid and level-0
+  // models), a keyframe switch (neighbour fit, re-anchoring) and the new keyframe's level-0
+  // models, or a pending coarse-level build. For a caller with spare
   // time once the frame's result is handed on; a no-op when nothing is pending.
   void run_deferred() noexcept;
   bool deferred_pending() const noexcept { return deferred_pending_; }
 
+  // From the first frame on (its models may still be pending in run_deferred()).
   bool has_reference() const noexcept { return has_reference_; }
+  // The next track() takes its frame as the reference (e.g. the working image changed).
+  void drop_reference() noexcept {
+    has_reference_ = false;
+    reference_pending_ = false;
+    deferred_pending_ = false;
+  }
   // The last track()'s coarse fallback: whether the coarse levels ran, how many windows failed
   // at level 0 from their warm start (the trigger's count), how many of those the frame before
   // had tracked, and how many more windows the frame tracked after the retry than before it
@@ -200,6 +209,7 @@ class BlockFlow {
     std::int32_t reanchor_tolerance_q16 = 0;
   };
 
+  void take_reference() noexcept;
   void build_level0() noexcept;
   void build_coarse() noexcept;  // when pending
   void build_models(int level) noexcept;
@@ -243,6 +253,7 @@ class BlockFlow {
   std::uint32_t frames_since_keyframe_ = 0;
   bool last_frame_was_keyframe_ = false;
   bool deferred_pending_ = false;    // the last track()'s run_deferred() has not run yet
+  bool reference_pending_ = false;   // the tare slot's level 0 is to become the reference
   bool coarse_built_ = false;        // coarse pyramid levels of the current frame exist
   bool key_coarse_pyramid_ = false;  // coarse pyramid levels of the keyframe exist
   bool key_level0_is_tare_ = false;  // level_models(0) is the tare frame's set

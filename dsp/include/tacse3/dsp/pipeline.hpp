@@ -129,7 +129,6 @@ class SensorPipeline {
   PipelineConfig config_{};
   Calibration cal_{};
   int min_tracked_points_ = 0;
-  bool tare_pending_ = false;
   // The working image's filter, from the image half of the calibration (antialias_filter).
   WorkImageFilter image_filter_ = WorkImageFilter::kBox;
   BlockFlow flow_{};

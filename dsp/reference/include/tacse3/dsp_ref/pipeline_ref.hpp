@@ -75,7 +75,6 @@ class SensorPipelineRef {
   NhhdRef nhhd_stage_;
   ContactDetectorRef contact_stage_;
   MotionRef motion_stage_;
-  bool tare_pending_ = true;
   dsp::WorkImage last_work_{};
   GridVectorD flow_, smoothed_, d_, r_, k_;
   GridMaskD flow_valid_, smoothed_valid_;
