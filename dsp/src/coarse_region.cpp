@@ -15,7 +15,7 @@ void CoarseRegion::build(const std::uint8_t* retry, int levels) noexcept {
     const int fw = flow_grid_width(l - 1), fh = flow_grid_height(l - 1);
     const int gw = flow_grid_width(l), gh = flow_grid_height(l);
     // The taps of the served cells: their corrections come from these.
-    std::array<std::uint8_t, kGridCount> taps{};
+    std::array<std::uint8_t, flow_grid_count(1)> taps{};
     for (int y = 0; y < fh; ++y) {
       int y0, y1;
       upsample_taps(y, gh, y0, y1);
@@ -33,19 +33,15 @@ void CoarseRegion::build(const std::uint8_t* retry, int levels) noexcept {
     std::uint8_t* track = track_.data() + flow_grid_offset(l);
     for (int y = 0; y < gh; ++y) {
       for (int x = 0; x < gw; ++x) {
-        bool near_tap = false;
-        for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, gh - 1) && !near_tap; ++ny) {
+        if (!taps[static_cast<std::size_t>(y * gw + x)]) continue;
+        for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, gh - 1); ++ny) {
           for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, gw - 1); ++nx) {
-            if (taps[static_cast<std::size_t>(ny * gw + nx)]) {
-              near_tap = true;
-              break;
-            }
+            track[ny * gw + nx] = 1;
           }
         }
-        track[y * gw + x] = near_tap ? 1 : 0;
-        count_ += near_tap ? 1 : 0;
       }
     }
+    for (int j = 0; j < gw * gh; ++j) count_ += track[j];
     served = track;  // their own warm starts take the next level's corrections
   }
 }

@@ -5,7 +5,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <memory>
 
 #include "tacse3/dsp/coarse_region.hpp"
 #include "tacse3/dsp/geometry.hpp"
@@ -412,8 +411,8 @@ void BlockFlowRef::coarse_levels(const dsp::GridMask* follow_valid) {
     const bool followed = follow_valid != nullptr && follow_valid->v[i] != 0 && m.solvable;
     retry[i] = static_cast<std::uint8_t>(!ok_[i] && (m.valid || followed));
   }
-  auto region = std::make_unique<dsp::CoarseRegion>();
-  region->build(retry.data(), levels);
+  dsp::CoarseRegion region;
+  region.build(retry.data(), levels);
   std::vector<std::vector<double>>& cx = cx_;
   std::vector<std::vector<double>>& cy = cy_;
   cx.assign(static_cast<std::size_t>(levels), {});
@@ -474,7 +473,7 @@ void BlockFlowRef::coarse_levels(const dsp::GridMask* follow_valid) {
         fx[i] = wx[ls][i] + ux;
         fy[i] = wy[ls][i] + uy;
         const WindowRef& m = models_[ls][i];
-        if (!m.valid || !region->tracked(l, static_cast<int>(i))) continue;
+        if (!m.valid || !region.tracked(l, static_cast<int>(i))) continue;
         const Result r = track_window(l, m, fx[i] / scale, fy[i] / scale, cfg_.coarse_iterations);
         if (!r.valid) continue;
         fx[i] = r.ux * scale;
