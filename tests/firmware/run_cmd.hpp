@@ -14,7 +14,7 @@
 namespace tacse3::test {
 
 struct RunResult {
-  int status = -1;  // exit status, -1 if the command did not exit normally
+  int status = -1;  // exit status; 128 + N if signal N ended it (as a shell says); -1 if no run
   std::string out;
 };
 
@@ -26,7 +26,8 @@ inline RunResult run_cmd(const std::string& cmd) {
   std::size_t n;
   while ((n = fread(buf, 1, sizeof(buf), p)) > 0) r.out.append(buf, n);
   const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  if (st != -1 && WIFEXITED(st)) r.status = WEXITSTATUS(st);
+  if (st != -1 && WIFSIGNALED(st)) r.status = 128 + WTERMSIG(st);
   return r;
 }
 

@@ -85,6 +85,25 @@ struct DaemonThread {
   void join() { t.join(); }
 };
 
+// Polls /api/state until it answers 200 (its body in *body) or the daemon has exited. The
+// daemon's run is bounded (--seconds counts from its first frame), so a loaded machine that is
+// slow to start it delays the test instead of failing it. False, with the last answer in *why,
+// if the daemon exited first.
+bool wait_live(httplib::Client& cli, const std::atomic<bool>& exited, std::string* body,
+               std::string* why) {
+  while (!exited.load()) {
+    if (auto r = cli.Get("/api/state"); r && r->status == 200) {
+      if (body != nullptr) *body = r->body;
+      return true;
+    } else {
+      *why = r ? "HTTP " + std::to_string(r->status) : httplib::to_string(r.error());
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  *why = "the daemon exited before /api/state answered 200; the last try: " + *why;
+  return false;
+}
+
 class ViewerTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -142,20 +161,17 @@ int mute_client(int port) {
 
 TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) {
   RunResult d;
-  DaemonThread run{std::thread(
-      [&] { d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 6 * kTimeScale)); })};
+  std::atomic<bool> exited{false};
+  DaemonThread run{std::thread([&] {
+    d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 6 * kTimeScale));
+    exited = true;
+  })};
   httplib::Client cli("127.0.0.1", port_);
   cli.set_connection_timeout(1);
   cli.set_read_timeout(2 * kTimeScale);
-  std::string first;
-  for (int i = 0; i < 100 && first.empty(); ++i) {
-    if (auto r = cli.Get("/api/state"); r && r->status == 200) {
-      first = r->body;
-    } else {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    }
-  }
-  ASSERT_FALSE(first.empty()) << "no /api/state within 10 s";
+  std::string first, why;
+  if (!wait_live(cli, exited, &first, &why)) run.join();
+  ASSERT_FALSE(first.empty()) << why << "\n" << d.out;
   // The board leaves the controls off: the command endpoint says which key turns them on.
   const auto refused = cli.Post("/api/command", R"({"command":"tare"})", "application/json");
   ASSERT_TRUE(refused);
@@ -278,19 +294,18 @@ TEST_F(ViewerTest, TareOverHttpIsTheCanTareWithItsAckAsTheAnswer) {
   text.replace(text.find("repeat = false"), 14, "repeat = true");
   std::ofstream(dir_ / "board.toml") << text << "\n[viewer]\ncontrols = true\n";
   RunResult d;
-  DaemonThread run{std::thread(
-      [&] { d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 4 * kTimeScale)); })};
+  std::atomic<bool> exited{false};
+  DaemonThread run{std::thread([&] {
+    d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 4 * kTimeScale));
+    exited = true;
+  })};
   httplib::Client cli("127.0.0.1", port_);
   cli.set_connection_timeout(1);
   cli.set_read_timeout(2 * kTimeScale);
-  bool live = false;
-  for (int i = 0; i < 100 && !live; ++i) {
-    auto r = cli.Get("/api/state");
-    live = r && r->status == 200;
-    if (!live) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  std::string why;
+  const bool live = wait_live(cli, exited, nullptr, &why);
   if (!live) run.join();
-  ASSERT_TRUE(live) << "no /api/state within 10 s\n" << d.out;
+  ASSERT_TRUE(live) << why << "\n" << d.out;
   EXPECT_NE(cli.Get("/api/info")->body.find("\"controls\":true,\"controls_off\":null"),
             std::string::npos);
   // The pose moves away from identity first (the object turns once the pads are in contact).
@@ -387,15 +402,15 @@ double median(std::vector<double> v) {
 RunResult paced_run(const std::string& daemon_cmd, int port, bool clients,
                     std::vector<std::vector<long>>* events) {
   RunResult d;
-  DaemonThread run{std::thread([&] { d = run_cmd(daemon_cmd); })};
+  std::atomic<bool> exited{false};
+  DaemonThread run{std::thread([&] {
+    d = run_cmd(daemon_cmd);
+    exited = true;
+  })};
   httplib::Client cli("127.0.0.1", port);
   cli.set_connection_timeout(1);
-  bool live = false;
-  for (int i = 0; i < 100 && !live; ++i) {
-    auto r = cli.Get("/api/state");
-    live = r && r->status == 200;
-    if (!live) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  std::string why;
+  const bool live = wait_live(cli, exited, nullptr, &why);
   int mute = -1;
   std::vector<std::thread> readers;
   events->assign(3, {});
@@ -422,7 +437,10 @@ RunResult paced_run(const std::string& daemon_cmd, int port, bool clients,
   run.join();
   for (auto& t : readers) t.join();
   if (mute >= 0) close(mute);
-  if (!live) d.status = -1;
+  if (!live) {
+    d.status = -1;
+    d.out += why + "\n";
+  }
   if (live && clients && mute < 0) {
     d.status = -2;
     d.out += std::string("mute client: ") + std::strerror(-mute) + "\n";
@@ -470,10 +488,11 @@ TEST_F(ViewerTest, EngineTimingHoldsWithFourClientsOneNeverReading) {
     for (auto& t : runs) t.join();
     for (int clients = 0; clients < 2; ++clients) {
       const RunResult& r = d[clients];
-      ASSERT_EQ(r.status, 0) << (clients ? "with" : "without")
-                             << " clients (-1: no /api/state, -2: the mute client could not "
-                                "connect)\n"
-                             << r.out;
+      ASSERT_EQ(r.status, 0)
+          << (clients ? "with" : "without")
+          << " clients (-1: no /api/state, -2: the mute client could not connect, "
+             "128 + N: signal N)\n"
+          << r.out;
       const EngineTiming t = summary_timing(r.out);
       ASSERT_TRUE(t.latency_p99_us > 0 && t.dsp_p50_us > 0) << "no timing in the summary\n"
                                                             << r.out;
