@@ -944,5 +944,104 @@ TEST(BlockFlowReference, FollowsTheGivenDecisions) {
   EXPECT_GE(snr_db(sig, err), 45.0);
 }
 
+// A window on the image's edge that the fixed path tracked: the decision-locked reference tracks
+// it too, although its own unrounded position leaves the image by less than the fixed path's
+// 1/32 px sampling step (the free-running reference reports it outside, and a followed point
+// that held its old value would drift from the fixed path's for as long as the shift lasts).
+TEST(BlockFlowReference, FollowsATrackedWindowOnTheImageEdge) {
+  BlockFlowConfig cfg;
+  cfg.pyramid_levels = 1;
+  int edge_cases = 0;
+  double worst = 0.0;
+  // About one working px towards the edge: the edge windows' origins are 1 px inside the image.
+  for (const double shift : {-1.97, -1.98, -1.99, -2.0, -2.01, -2.02}) {  // sensor px
+    auto f = make_flow(cfg);
+    dsp_ref::BlockFlowRef own(cfg), locked(cfg);
+    f->tare(undeformed());
+    own.tare(undeformed());
+    locked.tare(undeformed());
+    const WorkImage img = test::render_work_image(texture(), Warp::shift(shift, shift));
+    VectorField d;
+    GridMask v;
+    std::vector<double> ox, oy, lx, ly;
+    std::vector<std::uint8_t> ov, lv;
+    f->track(img, d, v);
+    own.track(img, ox, oy, ov);
+    const dsp_ref::FlowDecision follow{&v, false};
+    locked.track(img, lx, ly, lv, &follow);
+    for (int i = 0; i < kGridCount; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      const dsp_ref::WindowRef& m = own.window(0, i);
+      if (!v.v[u] || ov[u] || (m.ox != 1 && m.oy != 1)) continue;
+      ++edge_cases;  // tracked by the fixed path, outside for the free-running reference
+      ASSERT_TRUE(lv[u]);
+      worst =
+          std::max({worst, std::abs(d.x.v[u] / kQ16 - lx[u]), std::abs(d.y.v[u] / kQ16 - ly[u])});
+    }
+  }
+  std::printf(
+      "  edge windows tracked by the fixed path only: %d, locked reference within %.4f px\n",
+      edge_cases, worst);
+  EXPECT_GT(edge_cases, 0);
+  EXPECT_LE(worst, 1.0 / 32);
+}
+
+// The decision-locked reference places its level-0 windows at the fixed path's origins: here
+// origins moved by one pixel against its own rounding. The material point is the same, so the
+// window's offset takes up the move and the displacement still matches the fixed path's. Origins
+// that were never built (0: windows sit 1 px inside the image) are ignored.
+TEST(BlockFlowReference, FollowsTheFixedPathsWindowOrigins) {
+  BlockFlowConfig cfg;
+  cfg.pyramid_levels = 1;
+  auto f = make_flow(cfg);
+  dsp_ref::BlockFlowRef ref(cfg), unbuilt(cfg);
+  f->tare(undeformed());
+  ref.tare(undeformed());
+  unbuilt.tare(undeformed());
+  const WorkImage img = test::render_work_image(texture(), Warp::shift(0.8, -0.6));
+  VectorField d;
+  GridMask v;
+  f->track(img, d, v);
+  BlockFlow::WindowOrigins ox = f->window_origin_x(), oy = f->window_origin_y();
+  std::vector<int> moved;
+  for (int i = 0; i < kGridCount; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    const int gx = i % kGridWidth, gy = i / kGridWidth;
+    if (gx < 2 || gy < 2 || gx > kGridWidth - 3 || gy > kGridHeight - 3 || (gx + gy) % 7 != 0)
+      continue;
+    ox[u] = static_cast<std::int16_t>(ox[u] + 1);
+    oy[u] = static_cast<std::int16_t>(oy[u] - 1);
+    moved.push_back(i);
+  }
+  dsp_ref::FlowDecision follow{&v, false};
+  follow.origin_x = &ox;
+  follow.origin_y = &oy;
+  std::vector<double> rx, ry, ux, uy;
+  std::vector<std::uint8_t> rv, uv;
+  ref.track(img, rx, ry, rv, &follow);
+  const BlockFlow::WindowOrigins zero{};
+  dsp_ref::FlowDecision none{&v, false};
+  none.origin_x = &zero;
+  none.origin_y = &zero;
+  unbuilt.track(img, ux, uy, uv, &none);
+  double worst = 0.0;
+  int compared = 0;
+  for (int i = 0; i < kGridCount; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    ASSERT_EQ(ref.window(0, i).ox, ox[u]) << i;
+    ASSERT_EQ(ref.window(0, i).oy, oy[u]) << i;
+    ASSERT_EQ(unbuilt.window(0, i).ox, f->window_origin_x()[u]) << i;
+    ASSERT_EQ(unbuilt.window(0, i).oy, f->window_origin_y()[u]) << i;
+    if (!v.v[u] || !ref.window(0, i).valid) continue;
+    worst = std::max({worst, std::abs(d.x.v[u] / kQ16 - rx[u]), std::abs(d.y.v[u] / kQ16 - ry[u])});
+    ++compared;
+  }
+  std::printf("  %zu windows moved by a pixel; %d points within %.4f px of the fixed path\n",
+              moved.size(), compared, worst);
+  EXPECT_GT(moved.size(), 50u);
+  EXPECT_GT(compared, kGridCount / 2);
+  EXPECT_LE(worst, 0.05);
+}
+
 }  // namespace
 }  // namespace tacse3::dsp

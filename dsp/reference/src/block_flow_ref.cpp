@@ -221,6 +221,11 @@ void BlockFlowRef::build_level(int l) {
         const double py = dsp::kGridStride * jy + 1.5 + dy;
         m.ox = std::clamp(static_cast<int>(std::floor(px - kCentre + 0.5)), 1, w - kWin - 1);
         m.oy = std::clamp(static_cast<int>(std::floor(py - kCentre + 0.5)), 1, h - kWin - 1);
+        if (l == 0 && given_origins_ != nullptr) {
+          const auto g = static_cast<std::size_t>(jy * gw + jx);
+          m.ox = (*given_origins_->origin_x)[g];
+          m.oy = (*given_origins_->origin_y)[g];
+        }
         m.offset_x = px - (m.ox + kCentre);
         m.offset_y = py - (m.oy + kCentre);
         if (std::abs(m.offset_x) > max_off || std::abs(m.offset_y) > max_off) continue;
@@ -308,7 +313,7 @@ void BlockFlowRef::build_level(int l) {
 }
 
 BlockFlowRef::Result BlockFlowRef::track_window(int level, const WindowRef& m, double ux, double uy,
-                                                int iterations) const {
+                                                int iterations, bool inside) const {
   const auto ls = static_cast<std::size_t>(level);
   const PlaneRef& cur = cur_[ls];
   const PlaneRef& key = key_[ls];
@@ -323,6 +328,10 @@ BlockFlowRef::Result BlockFlowRef::track_window(int level, const WindowRef& m, d
     return fixed_point_sampling_ ? std::floor(v * 32 + 0.5) / 32 : v;
   };
   for (int it = 0; it < iterations; ++it) {
+    if (inside) {
+      ux = std::clamp(ux, static_cast<double>(-m.ox), max_x - m.ox);
+      uy = std::clamp(uy, static_cast<double>(-m.oy), max_y - m.oy);
+    }
     ux = grid(ux);
     uy = grid(uy);
     const double sx = m.ox + ux;
@@ -535,7 +544,7 @@ int BlockFlowRef::track_fine(bool retry, const dsp::GridMask* follow_valid) {
       if (!m.valid && !followed) continue;
       double ux = 0, uy = 0;
       if (retry) coarse_correction(0, gx, gy, ux, uy);
-      const Result r = track_window(0, m, tx_[i] + ux, ty_[i] + uy, cfg_.fine_iterations);
+      const Result r = track_window(0, m, tx_[i] + ux, ty_[i] + uy, cfg_.fine_iterations, followed);
       if (!r.outside) {
         est_x_[i] = r.ux;
         est_y_[i] = r.uy;
@@ -674,6 +683,24 @@ void BlockFlowRef::re_anchor(const FlowDecision* follow) {
   valid_ = reported_valid;
 }
 
+// Decision-locked mode: the keyframe's level-0 windows sit where the fixed path placed its own
+// (only the windows' models change; the keyframe displacements and window flows are the same).
+void BlockFlowRef::follow_origins(const FlowDecision& follow) {
+  if (follow.origin_x == nullptr || follow.origin_y == nullptr) return;
+  bool same = true;
+  for (std::size_t i = 0; i < models_[0].size(); ++i) {
+    const int ox = (*follow.origin_x)[i], oy = (*follow.origin_y)[i];
+    if (ox < 1 || oy < 1) return;  // windows sit 1 px inside the image: not built yet
+    same = same && models_[0][i].ox == ox && models_[0][i].oy == oy;
+  }
+  if (same) return;
+  given_origins_ = &follow;
+  build_level(0);
+  given_origins_ = nullptr;
+  key_valid_count_ = 0;
+  for (const WindowRef& m : models_[0]) key_valid_count_ += m.valid ? 1 : 0;
+}
+
 // Decision-locked mode: the fixed-point path's valid set replaces this frame's own. A point the
 // fixed path tracked takes the reference's own estimate even where its own tests failed (it
 // holds its previous value only if its window left the image or has no model); a point the
@@ -708,6 +735,8 @@ void BlockFlowRef::track(const dsp::WorkImage& frame, std::vector<double>& dx,
   }
   cur_ = build_pyramid_ref(frame, cfg_.pyramid_levels);
   const dsp::GridMask* follow_valid = follow != nullptr ? follow->valid : nullptr;
+  // Not in a switch frame: the fixed path's origins may already be its new keyframe's there.
+  if (follow_valid != nullptr && !follow->keyframe_switch) follow_origins(*follow);
   std::vector<double> held_x, held_y;
   if (follow_valid != nullptr) {
     held_x = tx_;

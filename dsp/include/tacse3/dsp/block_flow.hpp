@@ -168,6 +168,10 @@ class BlockFlow {
   const VectorField& keyframe_displacement() const noexcept { return key_displacement_; }
   // Translation of each level-0 window since the keyframe (Q16 working px).
   const VectorField& flow_from_keyframe() const noexcept { return window_flow_; }
+  // The level-0 windows' integer origins in the keyframe (working px), once its level 0 is built.
+  using WindowOrigins = std::array<std::int16_t, kGridCount>;
+  const WindowOrigins& window_origin_x() const noexcept { return window_origin_x_; }
+  const WindowOrigins& window_origin_y() const noexcept { return window_origin_y_; }
 
   // A keyframe's window models are built in bounded pieces: at a tare level 0 at once and the
   // coarse levels within two frames; at a switch level 0 in the switch's deferred work and the

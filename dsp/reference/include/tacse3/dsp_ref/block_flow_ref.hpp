@@ -68,6 +68,13 @@ struct FlowDecision {
   // own tolerance or validity test failed.
   const dsp::GridMask* reanchored = nullptr;
   const dsp::GridMask* lost = nullptr;
+  // The fixed path's level-0 window origins in its current keyframe (null: the reference
+  // places its own). Each origin rounds a keyframe displacement, so the two paths can place a
+  // window one pixel apart, and the flow-gradient stencils that need 3 px between windows then
+  // differ. Followed from the frame after a switch (the fixed path builds the new keyframe's
+  // level 0 in the switch's deferred work): the reference re-places its level-0 windows there.
+  const dsp::BlockFlow::WindowOrigins* origin_x = nullptr;
+  const dsp::BlockFlow::WindowOrigins* origin_y = nullptr;
 };
 
 // The block flow of dsp::BlockFlow in double: exact bilinear sampling at the real-valued
@@ -110,6 +117,7 @@ class BlockFlowRef {
   };
   void take_keyframe();
   void build_level(int level);
+  void follow_origins(const FlowDecision& follow);
   void coarse_levels(const dsp::GridMask* follow_valid);
   void coarse_correction(int level, int jx, int jy, double& ox, double& oy) const;
   // follow_valid (decision-locked track() only): also track the windows the fixed-point path
@@ -119,7 +127,10 @@ class BlockFlowRef {
   void re_anchor(const FlowDecision* follow);
   void follow_validity(const dsp::GridMask& valid, const std::vector<double>& held_x,
                        const std::vector<double>& held_y);
-  Result track_window(int level, const WindowRef& m, double ux, double uy, int iterations) const;
+  // inside: a window the fixed path tracked, so its sampling position is held in the image
+  // instead of reporting `outside` (the two paths' positions differ by their rounding).
+  Result track_window(int level, const WindowRef& m, double ux, double uy, int iterations,
+                      bool inside = false) const;
   bool fit_from_neighbours(int gx, int gy, double& ux, double& uy) const;
 
   dsp::BlockFlowConfig cfg_;
@@ -134,6 +145,8 @@ class BlockFlowRef {
   std::vector<double> est_x_, est_y_;
   std::vector<std::uint8_t> est_ok_;
   std::vector<std::vector<WindowRef>> models_;
+  // Level-0 origins given by follow_origins() for build_level() (null: its own rounding).
+  const FlowDecision* given_origins_ = nullptr;
   std::vector<double> dkx_, dky_;  // keyframe displacement
   std::vector<double> tx_, ty_;    // window flow since keyframe
   std::vector<double> outx_, outy_;

@@ -46,6 +46,8 @@ class DecisionFollower {
       d.flow.keyframe_switch = r.processed && r.keyframe_switched;
       d.flow.reanchored = levels_.flow ? &sp.flow().reanchored() : nullptr;
       d.flow.lost = levels_.flow ? &sp.flow().lost() : nullptr;
+      d.flow.origin_x = levels_.flow ? &sp.flow().window_origin_x() : nullptr;
+      d.flow.origin_y = levels_.flow ? &sp.flow().window_origin_y() : nullptr;
       d.contact = levels_.contact ? &f.contact.mask : nullptr;
     }
     return out_;
