@@ -3,6 +3,7 @@
 #include "tacse3/firmware/memory_lock.hpp"
 
 #include <link.h>
+#include <malloc.h>
 #include <sys/auxv.h>
 #include <sys/mman.h>
 #include <unistd.h>
@@ -11,10 +12,11 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <exception>
-#include <fstream>
-#include <sstream>
+#include <iterator>
+#include <string>
 
 namespace tacse3::firmware {
 
@@ -71,12 +73,22 @@ bool inside(const std::vector<LoadedObject>& objects, std::uintptr_t a) noexcept
 // read-only) has no page to read back, and touching it after a release raises SIGBUS.
 std::size_t release_clean_pages(const std::vector<LoadedObject>& keep) {
   const std::vector<LoadedObject> all = objects_containing({});
-  std::ifstream f("/proc/self/smaps");
-  std::stringstream text;
-  text << f.rdbuf();
+  // Line by line through a stack buffer: the file is ~250 KiB, and a heap copy of it on this
+  // thread would leave its pages resident, then locked.
+  std::vector<Mapping> mappings;
+  if (std::FILE* f = std::fopen("/proc/self/smaps", "re")) {
+    char line[1024];
+    bool line_start = true;
+    while (std::fgets(line, sizeof line, f) != nullptr) {
+      // A line longer than the buffer (a long path) is read in pieces: only its first counts.
+      if (line_start) scan_smaps_line(line, &mappings);
+      line_start = std::strchr(line, '\n') != nullptr;
+    }
+    std::fclose(f);
+  }
   std::size_t released = 0;
-  for (const Mapping& m : clean_file_mappings(text.str())) {
-    if (!inside(all, m.begin) || inside(keep, m.begin)) continue;
+  for (const Mapping& m : mappings) {
+    if (!clean(m) || !inside(all, m.begin) || inside(keep, m.begin)) continue;
     if (madvise(reinterpret_cast<void*>(m.begin), m.end - m.begin, MADV_DONTNEED) == 0)
       released += m.end - m.begin;
   }
@@ -85,35 +97,44 @@ std::size_t release_clean_pages(const std::vector<LoadedObject>& keep) {
 
 }  // namespace
 
+void scan_smaps_line(const char* line, std::vector<Mapping>* mappings) {
+  unsigned long lo = 0, hi = 0;
+  char perms[5] = {};
+  int used = 0;
+  // A mapping's header: "lo-hi perms offset dev inode [path]"; its fields: "Key: value kB".
+  if (std::sscanf(line, "%lx-%lx %4s %*s %*s %*s%n", &lo, &hi, perms, &used) == 3 && used > 0) {
+    Mapping m;
+    m.begin = lo;
+    m.end = hi;
+    m.writable = perms[1] == 'w';
+    const char* path = line + used;
+    while (*path == ' ') ++path;
+    m.file = *path == '/';
+    mappings->push_back(m);
+    return;
+  }
+  long kib = 0;
+  if (mappings->empty()) return;
+  if (std::sscanf(line, "Rss: %ld", &kib) == 1) mappings->back().rss_kib = kib;
+  if (std::sscanf(line, "Anonymous: %ld", &kib) == 1) mappings->back().anonymous_kib = kib;
+}
+
+bool clean(const Mapping& m) noexcept {
+  return m.file && !m.writable && m.anonymous_kib == 0;
+}
+
 std::vector<Mapping> clean_file_mappings(const std::string& smaps) {
   std::vector<Mapping> all;
-  std::istringstream in(smaps);
   std::string line;
-  while (std::getline(in, line)) {
-    unsigned long lo = 0, hi = 0;
-    char perms[5] = {};
-    int used = 0;
-    // A mapping's header: "lo-hi perms offset dev inode [path]"; its fields: "Key: value kB".
-    if (std::sscanf(line.c_str(), "%lx-%lx %4s %*s %*s %*s%n", &lo, &hi, perms, &used) == 3 &&
-        used > 0) {
-      Mapping m;
-      m.begin = lo;
-      m.end = hi;
-      m.writable = perms[1] == 'w';
-      const std::size_t path = line.find_first_not_of(' ', static_cast<std::size_t>(used));
-      m.file = path != std::string::npos && line[path] == '/';
-      all.push_back(m);
-      continue;
-    }
-    long kib = 0;
-    if (all.empty()) continue;
-    if (std::sscanf(line.c_str(), "Rss: %ld", &kib) == 1) all.back().rss_kib = kib;
-    if (std::sscanf(line.c_str(), "Anonymous: %ld", &kib) == 1) all.back().anonymous_kib = kib;
+  for (std::size_t at = 0; at < smaps.size();) {
+    const std::size_t end = std::min(smaps.find('\n', at), smaps.size());
+    line.assign(smaps, at, end - at);
+    at = end + 1;
+    scan_smaps_line(line.c_str(), &all);
   }
-  std::vector<Mapping> clean;
-  for (const Mapping& m : all)
-    if (m.file && !m.writable && m.anonymous_kib == 0) clean.push_back(m);
-  return clean;
+  std::vector<Mapping> out;
+  std::copy_if(all.begin(), all.end(), std::back_inserter(out), clean);
+  return out;
 }
 
 std::vector<LoadedObject> objects_containing(std::span<const void* const> code) {
@@ -142,8 +163,10 @@ std::span<const void* const> realtime_code() noexcept {
 MemoryLock lock_memory() {
   MemoryLock r;
   const std::vector<LoadedObject> realtime = objects_containing(realtime_code());
-  // Before mlockall: pages of a locked mapping cannot be released.
+  // Before mlockall: pages of a locked mapping cannot be released. Then the heap's free pages
+  // (start-up garbage, the smaps text above) go back too, or mlockall would keep them resident.
   r.released_bytes = release_clean_pages(realtime);
+  malloc_trim(0);
   if (mlockall(MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT) != 0) {
     const int e = errno;
     // EINVAL: a kernel without MCL_ONFAULT. Then everything, now.

@@ -47,6 +47,10 @@ struct Mapping {
 // by a file, not writable, no page copied on write. Dropping such pages loses nothing: a later
 // access reads them back from the page cache.
 std::vector<Mapping> clean_file_mappings(const std::string& smaps);
+// One line of that text: a header starts a mapping in *mappings, a field fills the last one.
+void scan_smaps_line(const char* line, std::vector<Mapping>* mappings);
+// Only clean file pages (see clean_file_mappings()).
+bool clean(const Mapping& m) noexcept;
 
 struct MemoryLock {
   bool locked = false;             // every page is locked once touched, the real-time objects now
