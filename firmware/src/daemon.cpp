@@ -53,10 +53,12 @@ constexpr int kRxTimeoutMs = 100;
 // The DSP loop's longest wait with nothing to do: a frame or a command rings it awake earlier
 // (Doorbell); the wait bounds how late a status or a stale pad is noticed.
 constexpr std::int64_t kIdleSleepNs = 200'000;
-constexpr std::size_t kDspStackPrefault = 256 * 1024;
+// The DSP thread's prefault: 4x the 16 KiB its loop touches (measured with a 4 KiB prefault,
+// sim board with the viewer serving every endpoint, and replay board).
+constexpr std::size_t kDspStackPrefault = 64 * 1024;
 // Stack sizes (docs/performance.md, "Thread stacks"): memory locking keeps a touched stack page
 // resident, so each thread gets what it was measured to touch, with a margin.
-// DSP: the prefault plus 256 KiB (measured: 12 KiB touched beyond the prefault). Capture and
+// DSP: the prefault plus 256 KiB. Capture and
 // RX: high-water marks of 16 and 8 KiB on the sim and replay boards; 128 KiB leaves 8x for the
 // V4L2 and libcamera paths, which cannot be measured off the board.
 constexpr std::size_t kDspStack = kDspStackPrefault + 256 * 1024;
