@@ -239,10 +239,14 @@ CameraStatus ReplayCamera::open() {
     largest = std::max(largest, static_cast<std::size_t>(sb.st_size));
   }
   nbufs_ = cfg_.buffer_count;
+  // Zeroed, so every slot is resident (and locked) from the start: under load the consumer holds
+  // more frames, and a slot's first use would otherwise fault on the capture thread.
   pixels_.reset(new std::uint8_t[frame_bytes_ * static_cast<std::size_t>(nbufs_)]());
   // Room for a file that grows a little after open() (a re-encoded frame); larger is an error.
   file_buf_bytes_ = largest + largest / 4 + 4096;
-  file_buf_.reset(new std::uint8_t[file_buf_bytes_]());
+  // Left uninitialised: read() fills it, and its margin's pages stay unmapped until a file needs
+  // them.
+  file_buf_ = std::make_unique_for_overwrite<std::uint8_t[]>(file_buf_bytes_);
   nominal_period_ns_ = static_cast<std::int64_t>(1e9 / in.fps);
 
   info_.format = channels_ == 3 ? dsp::PixelFormat::kRgb888 : dsp::PixelFormat::kGrey;
@@ -289,7 +293,7 @@ CameraStats ReplayCamera::stats() const {
 }
 
 void ReplayCamera::size_arena() {
-  // The trial arena is left uninitialised: only the pages the decode touches become resident.
+  // The arena is left uninitialised: only the pages the decodes touch become resident.
   arena_ = Arena{};
   arena_.mem = std::make_unique_for_overwrite<std::uint8_t[]>(kTrialArenaBytes);
   arena_.size = kTrialArenaBytes;
@@ -299,7 +303,7 @@ void ReplayCamera::size_arena() {
     size = (std::max(2 * arena_.peak, kMinArenaBytes) + 4095) & ~static_cast<std::size_t>(4095);
   }
   arena_ = Arena{};
-  arena_.mem.reset(new std::uint8_t[size]());
+  arena_.mem = std::make_unique_for_overwrite<std::uint8_t[]>(size);  // its calloc clears
   arena_.size = size;
   decodes_.store(0, std::memory_order_relaxed);
   arena_allocations_.store(0, std::memory_order_relaxed);
