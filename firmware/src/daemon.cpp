@@ -58,9 +58,9 @@ constexpr std::int64_t kIdleSleepNs = 200'000;
 constexpr std::size_t kDspStackPrefault = 64 * 1024;
 // Stack sizes (docs/performance.md, "Thread stacks"): memory locking keeps a touched stack page
 // resident, so each thread gets what it was measured to touch, with a margin.
-// DSP: the prefault plus 256 KiB. Capture and
-// RX: high-water marks of 16 and 8 KiB on the sim and replay boards; 128 KiB leaves 8x for the
-// V4L2 and libcamera paths, which cannot be measured off the board.
+// DSP: the prefault plus 256 KiB. Capture and RX: high-water marks of 16 and 8 KiB on the sim
+// and replay boards; 128 KiB leaves 8x for the V4L2 and libcamera paths, which cannot be
+// measured off the board.
 constexpr std::size_t kDspStack = kDspStackPrefault + 256 * 1024;
 // A capture thread also runs its pad's image stages: its 16 KiB plus the stages (within the DSP
 // loop's 12 KiB) are prefaulted with a margin, plus the 128 KiB for the camera paths.

@@ -88,7 +88,7 @@ std::size_t release_clean_pages(const std::vector<LoadedObject>& keep) {
   }
   std::size_t released = 0;
   for (const Mapping& m : mappings) {
-    if (!clean(m) || !inside(all, m.begin) || inside(keep, m.begin)) continue;
+    if (!is_clean_file_mapping(m) || !inside(all, m.begin) || inside(keep, m.begin)) continue;
     if (madvise(reinterpret_cast<void*>(m.begin), m.end - m.begin, MADV_DONTNEED) == 0)
       released += m.end - m.begin;
   }
@@ -119,7 +119,7 @@ void scan_smaps_line(const char* line, std::vector<Mapping>* mappings) {
   if (std::sscanf(line, "Anonymous: %ld", &kib) == 1) mappings->back().anonymous_kib = kib;
 }
 
-bool clean(const Mapping& m) noexcept {
+bool is_clean_file_mapping(const Mapping& m) noexcept {
   return m.file && !m.writable && m.anonymous_kib == 0;
 }
 
@@ -133,7 +133,7 @@ std::vector<Mapping> clean_file_mappings(const std::string& smaps) {
     scan_smaps_line(line.c_str(), &all);
   }
   std::vector<Mapping> out;
-  std::copy_if(all.begin(), all.end(), std::back_inserter(out), clean);
+  std::copy_if(all.begin(), all.end(), std::back_inserter(out), is_clean_file_mapping);
   return out;
 }
 

@@ -75,23 +75,29 @@ constexpr int kTimeScale = 1;
 constexpr bool kSanitized = false;
 #endif
 
-// The daemon's thread, joined on every way out of a test (a failed ASSERT returns early, and a
-// joinable std::thread left behind would terminate the test program).
+// Runs a daemon command on its own thread, its result into *out. Joined on every way out of a
+// test (a failed ASSERT returns early, and a joinable std::thread left behind would terminate
+// the test program).
 struct DaemonThread {
-  std::thread t;
+  DaemonThread(std::string cmd, RunResult* out)
+      : t([this, cmd = std::move(cmd), out] {
+          *out = run_cmd(cmd);
+          exited = true;
+        }) {}
   ~DaemonThread() {
     if (t.joinable()) t.join();
   }
   void join() { t.join(); }
+  std::atomic<bool> exited{false};  // before t: set by the thread t starts
+  std::thread t;
 };
 
 // Polls /api/state until it answers 200 (its body in *body) or the daemon has exited. The
 // daemon's run is bounded (--seconds counts from its first frame), so a loaded machine that is
 // slow to start it delays the test instead of failing it. False, with the last answer in *why,
 // if the daemon exited first.
-bool wait_live(httplib::Client& cli, const std::atomic<bool>& exited, std::string* body,
-               std::string* why) {
-  while (!exited.load()) {
+bool wait_live(httplib::Client& cli, const DaemonThread& run, std::string* body, std::string* why) {
+  while (!run.exited.load()) {
     if (auto r = cli.Get("/api/state"); r && r->status == 200) {
       if (body != nullptr) *body = r->body;
       return true;
@@ -161,16 +167,12 @@ int mute_client(int port) {
 
 TEST_F(ViewerTest, ServesLiveStateImagesAndStreamWhileTheCanStreamKeepsItsRate) {
   RunResult d;
-  std::atomic<bool> exited{false};
-  DaemonThread run{std::thread([&] {
-    d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 6 * kTimeScale));
-    exited = true;
-  })};
+  DaemonThread run(daemon("127.0.0.1:" + std::to_string(port_), 6 * kTimeScale), &d);
   httplib::Client cli("127.0.0.1", port_);
   cli.set_connection_timeout(1);
   cli.set_read_timeout(2 * kTimeScale);
   std::string first, why;
-  if (!wait_live(cli, exited, &first, &why)) run.join();
+  if (!wait_live(cli, run, &first, &why)) run.join();
   ASSERT_FALSE(first.empty()) << why << "\n" << d.out;
   // The board leaves the controls off: the command endpoint says which key turns them on.
   const auto refused = cli.Post("/api/command", R"({"command":"tare"})", "application/json");
@@ -294,16 +296,12 @@ TEST_F(ViewerTest, TareOverHttpIsTheCanTareWithItsAckAsTheAnswer) {
   text.replace(text.find("repeat = false"), 14, "repeat = true");
   std::ofstream(dir_ / "board.toml") << text << "\n[viewer]\ncontrols = true\n";
   RunResult d;
-  std::atomic<bool> exited{false};
-  DaemonThread run{std::thread([&] {
-    d = run_cmd(daemon("127.0.0.1:" + std::to_string(port_), 4 * kTimeScale));
-    exited = true;
-  })};
+  DaemonThread run(daemon("127.0.0.1:" + std::to_string(port_), 4 * kTimeScale), &d);
   httplib::Client cli("127.0.0.1", port_);
   cli.set_connection_timeout(1);
   cli.set_read_timeout(2 * kTimeScale);
   std::string why;
-  const bool live = wait_live(cli, exited, nullptr, &why);
+  const bool live = wait_live(cli, run, nullptr, &why);
   if (!live) run.join();
   ASSERT_TRUE(live) << why << "\n" << d.out;
   EXPECT_NE(cli.Get("/api/info")->body.find("\"controls\":true,\"controls_off\":null"),
@@ -402,15 +400,11 @@ double median(std::vector<double> v) {
 RunResult paced_run(const std::string& daemon_cmd, int port, bool clients,
                     std::vector<std::vector<long>>* events) {
   RunResult d;
-  std::atomic<bool> exited{false};
-  DaemonThread run{std::thread([&] {
-    d = run_cmd(daemon_cmd);
-    exited = true;
-  })};
+  DaemonThread run(daemon_cmd, &d);
   httplib::Client cli("127.0.0.1", port);
   cli.set_connection_timeout(1);
   std::string why;
-  const bool live = wait_live(cli, exited, nullptr, &why);
+  const bool live = wait_live(cli, run, nullptr, &why);
   int mute = -1;
   std::vector<std::thread> readers;
   events->assign(3, {});

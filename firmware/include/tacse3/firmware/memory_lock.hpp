@@ -50,7 +50,7 @@ std::vector<Mapping> clean_file_mappings(const std::string& smaps);
 // One line of that text: a header starts a mapping in *mappings, a field fills the last one.
 void scan_smaps_line(const char* line, std::vector<Mapping>* mappings);
 // Only clean file pages (see clean_file_mappings()).
-bool clean(const Mapping& m) noexcept;
+bool is_clean_file_mapping(const Mapping& m) noexcept;
 
 struct MemoryLock {
   bool locked = false;             // every page is locked once touched, the real-time objects now
