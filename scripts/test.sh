@@ -27,13 +27,19 @@ presets=("$@")
 if [ ${#presets[@]} -eq 0 ]; then presets=(host host-sanitize aarch64); fi
 
 declare -a summary=()
+# Each stage's wall time goes into the summary, so a slow CI run shows where its time went.
+stage_start=$SECONDS
+done_stage() {
+  summary+=("$1: ok ($((SECONDS - stage_start)) s)")
+  stage_start=$SECONDS
+}
 for preset in "${presets[@]}"; do
   echo "=== [$preset] configure + build ==="
   cmake --preset "$preset" >/dev/null
   cmake --build --preset "$preset" -j "$JOBS"
   echo "=== [$preset] ctest ==="
   ctest --preset "$preset" -j "$JOBS"
-  summary+=("$preset: ok")
+  done_stage "$preset"
 done
 
 # The armhf build's SIMD kernels (NEON on ARMv7) against their scalar path under qemu-arm, when
@@ -43,7 +49,7 @@ if [[ " ${presets[*]} " != *" armhf "* ]] && [ "${TACSE3_SKIP_ARMHF_SIMD:-0}" !=
   cmake --preset armhf >/dev/null
   cmake --build --preset armhf -j "$JOBS" --target dsp_test_simd
   ctest --preset armhf -j "$JOBS" -R '^Simd'
-  summary+=("armhf SIMD: ok")
+  done_stage "armhf SIMD"
 fi
 
 # The arm64 and armhf .deb packages, built and checked against tests/packaging/contents.txt, the
@@ -54,20 +60,20 @@ if [ "${TACSE3_SKIP_PACKAGE:-0}" != "1" ]; then
   scripts/package.sh
   echo "=== Python package (wheel, python3-tacse3 .deb) ==="
   scripts/package-python.sh
-  summary+=("package: ok")
+  done_stage package
 fi
 
 if [ -x fuzz/run.sh ] && [ "${TACSE3_SKIP_FUZZ:-0}" != "1" ]; then
   echo "=== fuzzers (bounded) ==="
   fuzz/run.sh
-  summary+=("fuzz: ok")
+  done_stage fuzz
 fi
 
 # Needs the host and aarch64 builds (the suite builds its few targets there if a preset was skipped).
 if [ "${TACSE3_SKIP_VM:-0}" != "1" ]; then
   echo "=== real-driver VM suite (tests/vm, qemu TCG) ==="
   TACSE3_VM_REQUIRE_DAEMON=1 tests/vm/suite.sh
-  summary+=("vm: ok")
+  done_stage vm
 fi
 
 echo "=== summary ==="
