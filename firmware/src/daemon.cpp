@@ -336,7 +336,9 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
   d->gpio_controller_ = std::make_unique<hal::GpioController>(*d->gpio_, timing);
 
   // The engine.
-  d->rings_ = std::make_unique<std::array<StagedRing, 2>>();
+  // Default-initialised: value-initialising the array would zero every slot of both queues and
+  // make them resident, where SpscSlotQueue builds only the slots the cameras fill.
+  d->rings_ = std::make_unique_for_overwrite<std::array<StagedRing, 2>>();
   d->command_rings_ = std::make_unique<std::array<CommandRing, 2>>();
   EngineConfig ec;
   ec.tx.endpoint = ep;

@@ -69,7 +69,7 @@ dsp::FusionMethod to_dsp(protocol::FusionMethod m) noexcept {
 
 Engine::Engine(const EngineConfig& config, dsp::DualPipeline& pipeline, hal::can::Channel& channel,
                std::array<hal::Camera*, 2> cameras, std::array<FrameRing*, 2> rings,
-               std::array<CommandRing*, 2> command_rings, SharedState& shared) noexcept
+               std::array<CommandRing*, 2> command_rings, SharedState& shared)
     : config_(config),
       pipeline_(pipeline),
       channel_(channel),
@@ -84,8 +84,17 @@ Engine::Engine(const EngineConfig& config, dsp::DualPipeline& pipeline, hal::can
       stream_enabled_(config.stream_enabled),
       velocity_mode_(config.velocity_mode) {
   for (std::size_t s = 0; s < 2; ++s) observed_[s].configured = config.configured[s];
+  if (rings[0] != nullptr || rings[1] != nullptr)
+    inline_frames_ = std::make_unique<std::array<StagedFrame, 2>>();
   base_calibration_ = {pipeline.sensor(dsp::SensorSlot::kLeft).calibration(),
                        pipeline.sensor(dsp::SensorSlot::kRight).calibration()};
+}
+
+void Engine::set_view(ViewSlot* slot) {
+  view_ = slot;
+  if (slot == nullptr) return;
+  view_copies_ = std::make_unique<ViewCopies>();
+  for (std::size_t s = 0; s < 2; ++s) stagers_[s].set_view_buffer(&view_copies_->staged[s]);
 }
 
 void Engine::start(std::int64_t now_ns) noexcept {
@@ -107,9 +116,10 @@ StagedFrame* Engine::take_frame(std::size_t s) noexcept {
   if (staged_rings_[s] != nullptr) return staged_rings_[s]->front();
   ArrivedFrame a;
   if (rings_[s] == nullptr || !rings_[s]->pop(a)) return nullptr;
-  stagers_[s].stage(a, inline_frames_[s]);
+  StagedFrame& f = (*inline_frames_)[s];
+  stagers_[s].stage(a, f);
   stagers_[s].run_deferred();  // as a pad's thread does once the frame is handed on
-  return &inline_frames_[s];
+  return &f;
 }
 
 void Engine::refill_heads(std::int64_t now_ns) noexcept {
@@ -672,8 +682,8 @@ void Engine::publish_view(std::int64_t now_ns) noexcept {
   v.dsp_us = have_result_ ? last_dsp_us_ : -1;
   v.latency_us = latency_.last_sample_us();
   for (std::size_t s = 0; s < 2; ++s) {
-    (void)stagers_[s].take_view_fields(&view_pads_[s], &view_contact_cells_[s]);
-    v.pads[s] = view_pads_[s];
+    (void)stagers_[s].take_view_fields(&view_copies_->pads[s], &view_contact_cells_[s]);
+    v.pads[s] = view_copies_->pads[s];
   }
   fill_view_pads(pipeline_, result_, state_, config_.configured, view_contact_cells_, &v);
   v.counters.cycles_sent = stats_.cycles_sent;

@@ -15,8 +15,8 @@ void PadStager::stage(const ArrivedFrame& f, StagedFrame& out) noexcept {
     sensor_.process_image(f.frame.view, out.stages);
     out.stage_us = (clock_() - t0) / 1000;
     out.staged = true;
-    if (view_state_.load(std::memory_order_acquire) == kViewWanted) {
-      viewer::fill_view_pad_fields(sensor_.fields(), &view_);
+    if (view_ != nullptr && view_state_.load(std::memory_order_acquire) == kViewWanted) {
+      viewer::fill_view_pad_fields(sensor_.fields(), view_);
       view_contact_cells_ = sensor_.fields().contact.count;
       view_state_.store(kViewFilled, std::memory_order_release);
     }
@@ -62,11 +62,11 @@ std::uint32_t PadStager::request_calibration(const dsp::Calibration& cal,
 bool PadStager::take_view_fields(viewer::ViewPad* out, int* contact_cells) noexcept {
   if (view_state_.load(std::memory_order_acquire) != kViewFilled) return false;
   *contact_cells = view_contact_cells_;
-  out->luma = view_.luma;
-  out->mask = view_.mask;
-  out->shear_x = view_.shear_x;
-  out->shear_y = view_.shear_y;
-  out->fz = view_.fz;
+  out->luma = view_->luma;
+  out->mask = view_->mask;
+  out->shear_x = view_->shear_x;
+  out->shear_y = view_->shear_y;
+  out->fz = view_->fz;
   view_state_.store(kViewIdle, std::memory_order_release);
   return true;
 }

@@ -133,16 +133,20 @@ TEST_F(PadStagerTest, AnUntakenCalibrationIsReplacedATakenOneWaitsForItsMotionHa
 
 TEST_F(PadStagerTest, TheViewersFieldsComeFromTheFirstFrameAfterTheyAreAsked) {
   viewer::ViewPad view;
+  auto copy = std::make_unique<viewer::ViewPad>();  // the pad's copy (Engine::set_view's)
   int cells = -1;
-  ASSERT_TRUE(stage_both(0));  // asked for from the start
+  ASSERT_TRUE(stage_both(0));
+  EXPECT_FALSE(stager_.take_view_fields(&view, &cells)) << "no buffer (no viewer): no copy";
+  stager_.set_view_buffer(copy.get());
+  ASSERT_TRUE(stage_both(1));  // asked for from the start
   ASSERT_TRUE(stager_.take_view_fields(&view, &cells));
   EXPECT_EQ(cells, ref_->fields().contact.count);
   EXPECT_EQ(view.luma[0], static_cast<std::uint8_t>(ref_->fields().work.px[0] >> 2));
   EXPECT_FALSE(stager_.take_view_fields(&view, &cells)) << "taken once";
-  ASSERT_TRUE(stage_both(1));
+  ASSERT_TRUE(stage_both(2));
   EXPECT_FALSE(stager_.take_view_fields(&view, &cells)) << "not asked again";
   stager_.want_view_fields();
-  ASSERT_TRUE(stage_both(2));
+  ASSERT_TRUE(stage_both(3));
   ASSERT_TRUE(stager_.take_view_fields(&view, &cells));
   for (std::size_t i = 0; i < view.shear_x.size(); ++i) {
     ASSERT_EQ(view.shear_x[i], static_cast<float>(ref_->fields().shear.x.v[i]) /

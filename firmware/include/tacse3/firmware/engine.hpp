@@ -102,7 +102,7 @@ class Engine {
   // The pipeline must be configured; cameras may be null (no such sensor / tests without one).
   Engine(const EngineConfig& config, dsp::DualPipeline& pipeline, hal::can::Channel& channel,
          std::array<hal::Camera*, 2> cameras, std::array<FrameRing*, 2> rings,
-         std::array<CommandRing*, 2> command_rings, SharedState& shared) noexcept;
+         std::array<CommandRing*, 2> command_rings, SharedState& shared);
 
   void start(std::int64_t now_ns) noexcept;
   // --record: every processed instant also goes to the recorder (null: not recording). Set
@@ -110,8 +110,9 @@ class Engine {
   // SharedState::recording).
   void set_recorder(FrameRecorder* recorder) noexcept { recorder_ = recorder; }
   // --http: the slot the live viewer reads (null: no viewer, nothing is published). Set before
-  // the DSP thread starts.
-  void set_view(ViewSlot* slot) noexcept { view_ = slot; }
+  // the DSP thread starts; it allocates the viewer's per-pad copies, which a daemon without a
+  // viewer never holds.
+  void set_view(ViewSlot* slot);
   // [viewer] controls: the mailbox the viewer's POST /api/command writes (null: no controls).
   // Set before the DSP thread starts.
   void set_web_commands(CommandMailbox* box) noexcept { web_commands_ = box; }
@@ -180,7 +181,8 @@ class Engine {
   std::array<StagedRing*, 2> staged_rings_{};
   std::array<PadStager, 2> stagers_;
   std::array<Head, 2> heads_{};
-  std::array<StagedFrame, 2> inline_frames_{};  // a pad staged here, from its raw ring
+  // A pad staged here, from its raw ring: allocated only when the constructor is given one.
+  std::unique_ptr<std::array<StagedFrame, 2>> inline_frames_;
   // Each pad's motion half follows its image half (PadStager): the tare and calibration epochs
   // its motion state is at, and the calibration whose image half was posted last.
   std::array<std::uint32_t, 2> motion_tare_epoch_{};
@@ -191,9 +193,14 @@ class Engine {
   std::array<bool, 2> reload_posted_{};                   // its image half posted to the pad
   bool reload_started_ = false;
   std::array<int, 2> contact_cells_{};  // |Ω| of each pad's last frame in a cycle
-  // The viewer's grid fields and image of each pad, and |Ω| in them: a frame staged at most a
-  // frame period before the view is due (PadStager::want_view_fields).
-  std::array<viewer::ViewPad, 2> view_pads_{};
+  // With a viewer (set_view): the viewer's grid fields and image of each pad, from a frame staged
+  // at most a frame period before the view is due (PadStager::want_view_fields), and the copies
+  // the pads' threads fill for them.
+  struct ViewCopies {
+    std::array<viewer::ViewPad, 2> pads{};
+    std::array<viewer::ViewPad, 2> staged{};
+  };
+  std::unique_ptr<ViewCopies> view_copies_;
   std::array<int, 2> view_contact_cells_{};
   std::array<SensorObservation, 2> observed_{};
   std::array<std::uint64_t, 2> pairing_drops_{};

@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "tacse3/dsp/pipeline.hpp"
+#include "tacse3/firmware/slot_queue.hpp"
 #include "tacse3/hal/camera.hpp"
 #include "tacse3/hal/camera/spsc_ring.hpp"
 #include "tacse3/viewer/view_snapshot.hpp"
@@ -35,9 +36,11 @@ struct StagedFrame {
   std::uint32_t tare_epoch = 0;
   std::uint32_t calibration_epoch = 0;
 };
-// Pad thread -> DSP thread, written and read in place (hal::SpscRing's back() and front()): a
-// staged frame is 31 KB, and copying it in and out would cost more than the hand-off.
-using StagedRing = hal::SpscRing<StagedFrame, 8>;
+// Pad thread -> DSP thread, written and read in place (back() and front()): a staged frame is
+// 31 KB, and copying it in and out would cost more than the hand-off. A staged frame keeps its
+// camera buffer until the DSP thread pops it, so the cameras' buffer_count (at most 16) bounds
+// how many are in use; only those slots are ever built (SpscSlotQueue).
+using StagedRing = SpscSlotQueue<StagedFrame, 16>;
 
 // Owns one pad's image state (SensorPipeline::process_image, tare_image, set_image_calibration):
 // stage() and run_deferred() are called by one thread only, the pad's; the other members by the
@@ -78,6 +81,9 @@ class PadStager {
   // has not seen a frame of that epoch yet: its motion half still waits). A request the pad has
   // not taken yet is replaced (a lost pad never takes one).
   std::uint32_t request_calibration(const dsp::Calibration& cal, bool after_taken) noexcept;
+  // Before the pad's thread starts: where the pad thread copies the viewer's fields (null, the
+  // default: no viewer, nothing is copied).
+  void set_view_buffer(viewer::ViewPad* buffer) noexcept { view_ = buffer; }
   // DSP thread: asks for the viewer's fields of the next staged frame (a view is due soon).
   void want_view_fields() noexcept {
     int idle = kViewIdle;
@@ -105,7 +111,7 @@ class PadStager {
   std::uint32_t calibration_posted_ = 0;
   std::uint32_t calibration_applied_ = 0;  // pad thread
   std::atomic<int> view_state_{kViewWanted};
-  viewer::ViewPad view_{};  // the grid fields and image only
+  viewer::ViewPad* view_ = nullptr;  // the grid fields and image only
   int view_contact_cells_ = 0;
 };
 

@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: Apache-2.0
+// SpscSlotQueue: FIFO order, capacity, the lowest free slot first, elements built only in slots
+// that are handed out, and two threads that lose nothing.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+#include <set>
+#include <thread>
+
+#include "tacse3/firmware/slot_queue.hpp"
+
+namespace tacse3::firmware {
+namespace {
+
+struct Counted {
+  static inline int built = 0;
+  static inline int destroyed = 0;
+  Counted() noexcept { ++built; }
+  ~Counted() { ++destroyed; }
+  std::uint32_t value = 0;
+  std::array<std::uint32_t, 15> payload{};  // the rest of a 64-byte element
+};
+
+TEST(SpscSlotQueue, HandsSlotsOverInOrderUpToItsCapacity) {
+  SpscSlotQueue<std::uint32_t, 4> q;
+  EXPECT_EQ(q.front(), nullptr);
+  for (std::uint32_t v = 0; v < 4; ++v) {
+    std::uint32_t* s = q.back();
+    ASSERT_NE(s, nullptr) << v;
+    *s = 10 + v;
+    q.commit();
+  }
+  EXPECT_EQ(q.back(), nullptr) << "a full queue refuses";
+  EXPECT_EQ(q.size(), 4u);
+  for (std::uint32_t v = 0; v < 4; ++v) {
+    const std::uint32_t* s = q.front();
+    ASSERT_NE(s, nullptr);
+    EXPECT_EQ(*s, 10 + v);
+    q.pop();
+  }
+  EXPECT_TRUE(q.empty());
+  q.pop();  // popping an empty queue changes nothing
+  EXPECT_TRUE(q.empty());
+  EXPECT_NE(q.back(), nullptr);
+}
+
+// A ring would walk through all 16 slots; one or two in flight use only the lowest two.
+TEST(SpscSlotQueue, ReusesTheLowestFreeSlotsAndBuildsNoOther) {
+  Counted::built = Counted::destroyed = 0;
+  {
+    SpscSlotQueue<Counted, 16> q;
+    EXPECT_EQ(Counted::built, 0) << "no slot is built before it is handed out";
+    std::set<const Counted*> used;
+    for (std::uint32_t i = 0; i < 100; ++i) {
+      Counted* a = q.back();
+      ASSERT_NE(a, nullptr);
+      a->value = 2 * i;
+      q.commit();
+      Counted* b = q.back();
+      ASSERT_NE(b, nullptr);
+      b->value = 2 * i + 1;
+      q.commit();
+      used.insert(a);
+      used.insert(b);
+      ASSERT_EQ(q.front()->value, 2 * i);
+      q.pop();
+      ASSERT_EQ(q.front()->value, 2 * i + 1);
+      q.pop();
+    }
+    EXPECT_EQ(used.size(), 2u);
+    EXPECT_EQ(q.slots_built(), 2u);
+    EXPECT_EQ(Counted::built, 2);
+  }
+  EXPECT_EQ(Counted::destroyed, 2) << "the built slots are destroyed with the queue";
+}
+
+// A slot freed in the middle is the next one filled, and the order stays the commit order.
+TEST(SpscSlotQueue, FillsAFreedSlotNextAndKeepsTheCommitOrder) {
+  SpscSlotQueue<std::uint32_t, 4> q;
+  const auto put = [&q](std::uint32_t v) {
+    std::uint32_t* s = q.back();
+    if (s != nullptr) {
+      *s = v;
+      q.commit();
+    }
+    return s;
+  };
+  const std::uint32_t* first = put(0);
+  ASSERT_NE(first, nullptr);
+  ASSERT_NE(put(1), nullptr);
+  ASSERT_NE(put(2), nullptr);
+  q.pop();  // frees the first slot
+  EXPECT_EQ(put(3), first) << "the lowest free slot";
+  for (std::uint32_t v = 1; v <= 3; ++v) {
+    const std::uint32_t* s = q.front();
+    ASSERT_NE(s, nullptr);
+    if (s != nullptr) {
+      EXPECT_EQ(*s, v);
+    }
+    q.pop();
+  }
+  EXPECT_TRUE(q.empty());
+}
+
+TEST(SpscSlotQueue, TwoThreadsKeepOrderAndLoseNothing) {
+  SpscSlotQueue<Counted, 8> q;
+  constexpr std::uint32_t kCount = 200'000;
+  std::thread producer([&] {
+    for (std::uint32_t i = 0; i < kCount;) {
+      Counted* s = q.back();
+      if (s == nullptr) {
+        std::this_thread::yield();  // full: let the consumer run (2-core CI)
+        continue;
+      }
+      s->value = i;
+      s->payload.fill(i * 7U);
+      q.commit();
+      ++i;
+    }
+  });
+  std::uint32_t expected = 0;
+  std::uint64_t mismatches = 0;
+  while (expected < kCount) {
+    const Counted* s = q.front();
+    if (s == nullptr) {
+      std::this_thread::yield();
+      continue;
+    }
+    if (s->value != expected || s->payload.front() != expected * 7U ||
+        s->payload.back() != expected * 7U)
+      ++mismatches;
+    q.pop();
+    ++expected;
+  }
+  producer.join();
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_TRUE(q.empty());
+  EXPECT_LE(q.slots_built(), 8u);
+}
+
+}  // namespace
+}  // namespace tacse3::firmware
