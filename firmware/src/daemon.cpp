@@ -337,8 +337,14 @@ std::unique_ptr<Daemon> Daemon::create(const config::BoardConfig& board, const O
 
   // The engine.
   // Default-initialised: value-initialising the array would zero every slot of both queues and
-  // make them resident, where SpscSlotQueue builds only the slots the cameras fill.
+  // make them resident. A staged frame holds its camera buffer, so a pad never has more staged
+  // frames than its camera has buffers: those slots are built now, before the memory is locked,
+  // so the pad thread takes no page fault when a backlog first grows; the others never are.
   d->rings_ = std::make_unique_for_overwrite<std::array<StagedRing, 2>>();
+  for (std::size_t s = 0; s < 2; ++s) {
+    if (d->cameras_[s] != nullptr)
+      (*d->rings_)[s].reserve(static_cast<std::size_t>(d->cameras_[s]->info().buffer_count));
+  }
   d->command_rings_ = std::make_unique<std::array<CommandRing, 2>>();
   EngineConfig ec;
   ec.tx.endpoint = ep;

@@ -91,10 +91,11 @@ Engine::Engine(const EngineConfig& config, dsp::DualPipeline& pipeline, hal::can
 }
 
 void Engine::set_view(ViewSlot* slot) {
+  if (slot != nullptr) {
+    view_copies_ = std::make_unique<ViewCopies>();
+    for (std::size_t s = 0; s < 2; ++s) stagers_[s].set_view_buffer(&view_copies_->staged[s]);
+  }
   view_ = slot;
-  if (slot == nullptr) return;
-  view_copies_ = std::make_unique<ViewCopies>();
-  for (std::size_t s = 0; s < 2; ++s) stagers_[s].set_view_buffer(&view_copies_->staged[s]);
 }
 
 void Engine::start(std::int64_t now_ns) noexcept {
@@ -139,8 +140,11 @@ void Engine::refill_heads(std::int64_t now_ns) noexcept {
 void Engine::release_head(std::size_t s) noexcept {
   Head& h = heads_[s];
   if (!h.pending.present) return;
-  if (cameras_[s] != nullptr) cameras_[s]->release(h.f->arrived.frame);
+  // The slot first, then the camera buffer: the camera's next frame, staged into a slot, then
+  // always finds one free, so a pad never has more staged frames than camera buffers.
+  const hal::Frame frame = h.f->arrived.frame;
   if (staged_rings_[s] != nullptr) staged_rings_[s]->pop();
+  if (cameras_[s] != nullptr) cameras_[s]->release(frame);
   h.pending.present = false;
   h.f = nullptr;
 }

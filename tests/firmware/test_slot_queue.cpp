@@ -22,24 +22,38 @@ struct Counted {
   std::array<std::uint32_t, 15> payload{};  // the rest of a 64-byte element
 };
 
-TEST(SpscSlotQueue, HandsSlotsOverInOrderUpToItsCapacity) {
-  SpscSlotQueue<std::uint32_t, 4> q;
-  EXPECT_EQ(q.front(), nullptr);
-  for (std::uint32_t v = 0; v < 4; ++v) {
-    std::uint32_t* s = q.back();
-    ASSERT_NE(s, nullptr) << v;
-    *s = 10 + v;
+using Queue4 = SpscSlotQueue<std::uint32_t, 4>;
+
+// Fills the next slot with v and hands it over; the slot, or null when the queue was full.
+std::uint32_t* put(Queue4& q, std::uint32_t v) {
+  std::uint32_t* s = q.back();
+  if (s != nullptr) {
+    *s = v;
     q.commit();
   }
-  EXPECT_EQ(q.back(), nullptr) << "a full queue refuses";
-  EXPECT_EQ(q.size(), 4u);
-  for (std::uint32_t v = 0; v < 4; ++v) {
+  return s;
+}
+
+// Pops first..last and checks each value, then that the queue is empty.
+void expect_pops(Queue4& q, std::uint32_t first, std::uint32_t last) {
+  for (std::uint32_t v = first; v <= last; ++v) {
     const std::uint32_t* s = q.front();
-    ASSERT_NE(s, nullptr);
-    EXPECT_EQ(*s, 10 + v);
+    ASSERT_NE(s, nullptr) << v;
+    if (s != nullptr) {
+      EXPECT_EQ(*s, v);
+    }
     q.pop();
   }
   EXPECT_TRUE(q.empty());
+}
+
+TEST(SpscSlotQueue, HandsSlotsOverInOrderUpToItsCapacity) {
+  Queue4 q;
+  EXPECT_EQ(q.front(), nullptr);
+  for (std::uint32_t v = 0; v < 4; ++v) ASSERT_NE(put(q, v), nullptr) << v;
+  EXPECT_EQ(q.back(), nullptr) << "a full queue refuses";
+  EXPECT_EQ(q.size(), 4u);
+  expect_pops(q, 0, 3);
   q.pop();  // popping an empty queue changes nothing
   EXPECT_TRUE(q.empty());
   EXPECT_NE(q.back(), nullptr);
@@ -77,30 +91,14 @@ TEST(SpscSlotQueue, ReusesTheLowestFreeSlotsAndBuildsNoOther) {
 
 // A slot freed in the middle is the next one filled, and the order stays the commit order.
 TEST(SpscSlotQueue, FillsAFreedSlotNextAndKeepsTheCommitOrder) {
-  SpscSlotQueue<std::uint32_t, 4> q;
-  const auto put = [&q](std::uint32_t v) {
-    std::uint32_t* s = q.back();
-    if (s != nullptr) {
-      *s = v;
-      q.commit();
-    }
-    return s;
-  };
-  const std::uint32_t* first = put(0);
+  Queue4 q;
+  const std::uint32_t* first = put(q, 0);
   ASSERT_NE(first, nullptr);
-  ASSERT_NE(put(1), nullptr);
-  ASSERT_NE(put(2), nullptr);
+  ASSERT_NE(put(q, 1), nullptr);
+  ASSERT_NE(put(q, 2), nullptr);
   q.pop();  // frees the first slot
-  EXPECT_EQ(put(3), first) << "the lowest free slot";
-  for (std::uint32_t v = 1; v <= 3; ++v) {
-    const std::uint32_t* s = q.front();
-    ASSERT_NE(s, nullptr);
-    if (s != nullptr) {
-      EXPECT_EQ(*s, v);
-    }
-    q.pop();
-  }
-  EXPECT_TRUE(q.empty());
+  EXPECT_EQ(put(q, 3), first) << "the lowest free slot";
+  expect_pops(q, 1, 3);
 }
 
 TEST(SpscSlotQueue, TwoThreadsKeepOrderAndLoseNothing) {
@@ -136,7 +134,45 @@ TEST(SpscSlotQueue, TwoThreadsKeepOrderAndLoseNothing) {
   producer.join();
   EXPECT_EQ(mismatches, 0u);
   EXPECT_TRUE(q.empty());
-  EXPECT_LE(q.slots_built(), 8u);
+}
+
+// The capture loop asks again while it waits: a retry after the consumer freed a lower slot gets
+// that slot, and commit() hands over the one the last back() returned.
+TEST(SpscSlotQueue, ARetriedBackCommitsTheSlotItReturnedLast) {
+  Queue4 q;
+  ASSERT_NE(put(q, 0), nullptr);
+  ASSERT_NE(put(q, 1), nullptr);
+  const std::uint32_t* third = q.back();  // slot 2, not filled
+  q.pop();                                // frees slot 0
+  std::uint32_t* again = q.back();
+  ASSERT_NE(again, nullptr);
+  EXPECT_NE(again, third) << "the lower slot, freed in between";
+  *again = 2;
+  q.commit();
+  expect_pops(q, 1, 2);
+  EXPECT_EQ(q.slots_built(), 3u);
+}
+
+// reserve() builds the slots a producer will use up front, and back() then builds no other.
+TEST(SpscSlotQueue, ReserveBuildsTheFirstSlotsOnly) {
+  Counted::built = Counted::destroyed = 0;
+  {
+    SpscSlotQueue<Counted, 16> q;
+    q.reserve(4);
+    EXPECT_EQ(Counted::built, 4);
+    EXPECT_EQ(q.slots_built(), 4u);
+    for (int round = 0; round < 50; ++round) {
+      for (int k = 0; k < 4; ++k) {
+        ASSERT_NE(q.back(), nullptr);
+        q.commit();
+      }
+      for (int k = 0; k < 4; ++k) q.pop();
+    }
+    EXPECT_EQ(Counted::built, 4) << "four in use at most: no fifth slot built";
+    q.reserve(40);  // clamped to the capacity
+    EXPECT_EQ(q.slots_built(), 16u);
+  }
+  EXPECT_EQ(Counted::destroyed, 16);
 }
 
 }  // namespace

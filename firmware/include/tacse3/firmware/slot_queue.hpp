@@ -31,7 +31,9 @@ class SpscSlotQueue {
   static_assert(std::is_default_constructible_v<T>, "slots are built in place by back()");
 
  public:
-  // User-provided, so that value-initialising an owner (make_unique) does not zero storage_.
+  // User-provided, so that default-initialising the queue leaves storage_ untouched. An owner
+  // that is value-initialised (make_unique<std::array<...>>()) is still zeroed in full: the
+  // daemon uses make_unique_for_overwrite.
   SpscSlotQueue() noexcept {}  // NOLINT(modernize-use-equals-default)
   SpscSlotQueue(const SpscSlotQueue&) = delete;
   SpscSlotQueue& operator=(const SpscSlotQueue&) = delete;
@@ -40,15 +42,17 @@ class SpscSlotQueue {
       if ((built_ >> i) & 1U) slot(i)->~T();
   }
 
+  // Producer, before the consumer runs: builds the first n slots now (n is clamped to the
+  // capacity), so that a producer which never has more than n in use takes no page fault later.
+  void reserve(std::size_t n) noexcept {
+    for (std::size_t i = 0; i < n && i < Capacity; ++i) build(i);
+  }
   // Producer: the lowest free slot, or null when every slot is filled; commit() hands it over.
   T* back() noexcept {
     const std::uint32_t free = free_.load(std::memory_order_acquire);
     if (free == 0) return nullptr;
     next_ = static_cast<std::uint8_t>(std::countr_zero(free));
-    if (((built_ >> next_) & 1U) == 0) {
-      ::new (static_cast<void*>(slot(next_))) T();
-      built_ |= std::uint32_t{1} << next_;
-    }
+    build(next_);
     return slot(next_);
   }
   // Producer: hands over the slot the last back() returned.
@@ -79,8 +83,13 @@ class SpscSlotQueue {
   }
 
  private:
-  T* slot(std::size_t i) noexcept {
-    return std::launder(reinterpret_cast<T*>(storage_.data() + i * sizeof(T)));
+  void* raw(std::size_t i) noexcept { return storage_.data() + i * sizeof(T); }
+  // Only for a built slot: launder needs the object to exist.
+  T* slot(std::size_t i) noexcept { return std::launder(static_cast<T*>(raw(i))); }
+  void build(std::size_t i) noexcept {
+    if ((built_ >> i) & 1U) return;
+    ::new (raw(i)) T();
+    built_ |= std::uint32_t{1} << i;
   }
 
   static constexpr std::uint32_t kAllFree =
