@@ -2,6 +2,7 @@
 // tacse3 tools: in-memory simulated recordings for the benchmark and the accuracy test.
 #include "tacse3/tools/sim_source.hpp"
 
+#include <atomic>
 #include <cmath>
 
 namespace tacse3::tools {
@@ -60,9 +61,38 @@ std::unique_ptr<SimSource> SimSource::create(const sim::SimConfig& config, const
   return s;
 }
 
+namespace {
+// Bytes of kept frames, over every SimSource of the process (the benchmark reads several
+// recordings on several threads).
+std::atomic<std::size_t> g_cached_bytes{0};
+}  // namespace
+
+SimSource::~SimSource() {
+  g_cached_bytes.fetch_sub(cached_bytes_, std::memory_order_relaxed);
+}
+
 std::string SimSource::read(std::size_t index, std::array<const dsp::FrameView*, 2>* views) {
   *views = {nullptr, nullptr};
   if (index >= info_.t_ns.size()) return info_.name + ": frame index out of range";
+  const bool kept = index < cache_.size() && !cache_[index][info_.has_sensor[0] ? 0 : 1].empty();
+  if (kept) {
+    ++cache_hits_;
+  } else if (std::string e = simulate_to(index); !e.empty()) {
+    return e;
+  }
+  for (std::size_t k = 0; k < 2; ++k) {
+    if (!info_.has_sensor[k]) continue;
+    const std::uint8_t* px = kept ? cache_[index][k].data() : buf_[k].data();
+    views_[k] = frame_view(px, info_.width, info_.height, channels_);
+    (*views)[k] = &views_[k];
+  }
+  return {};
+}
+
+// Simulates up to frame `index` and renders it into buf_: from the frame after the last one
+// simulated, or from frame 0 when `index` is not after it. Its labels follow the frames
+// simulated; a frame served from the cache changes neither.
+std::string SimSource::simulate_to(std::size_t index) {
   if (static_cast<std::int64_t>(index) <= last_) {
     for (std::size_t k = 0; k < 2; ++k) sim_->reset(static_cast<sim::Sensor>(k));
     info_.labels.clear();
@@ -83,12 +113,23 @@ std::string SimSource::read(std::size_t index, std::array<const dsp::FrameView*,
     }
   }
   last_ = static_cast<std::int64_t>(index);
-  for (std::size_t k = 0; k < 2; ++k) {
-    if (!info_.has_sensor[k]) continue;
-    views_[k] = frame_view(buf_[k].data(), info_.width, info_.height, channels_);
-    (*views)[k] = &views_[k];
-  }
+  keep(index);
   return {};
+}
+
+// Copies the frame just rendered into the cache while the process-wide budget allows.
+void SimSource::keep(std::size_t index) {
+  std::size_t bytes = 0;
+  for (std::size_t k = 0; k < 2; ++k) bytes += info_.has_sensor[k] ? buf_[k].size() : 0;
+  std::size_t used = g_cached_bytes.load(std::memory_order_relaxed);
+  do {
+    if (used + bytes > kFrameCacheBytes) return;
+  } while (!g_cached_bytes.compare_exchange_weak(used, used + bytes, std::memory_order_relaxed));
+  cached_bytes_ += bytes;
+  if (cache_.empty()) cache_.resize(info_.t_ns.size());
+  for (std::size_t k = 0; k < 2; ++k) {
+    if (info_.has_sensor[k]) cache_[index][k] = buf_[k];
+  }
 }
 
 rec::SimLabel sim_label(const sim::Simulator& simulator, sim::Sensor sensor, std::int64_t index,

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -19,9 +21,11 @@ recording::SimLabel sim_label(const sim::Simulator& simulator, sim::Sensor senso
                               std::int64_t index, std::int64_t t_ns);
 
 // Exactly what `tacse3-sim` would write for the same configuration (frame times, truth,
-// sim_labels), but the frames are rendered on demand and never touch the disk. Reading an index
-// not after the previous one restarts the simulation from frame 0 (the slide regime integrates
-// a lag, so frames are rendered in order).
+// sim_labels), but the frames are rendered on demand and never touch the disk. A rendered frame
+// is kept, within a budget shared by every SimSource of the process (kFrameCacheBytes), so a
+// calibration's later passes over the same recording do not simulate it again. Reading an index
+// not after the previous one that is not kept restarts the simulation from frame 0 (the slide
+// regime integrates a lag, so frames are rendered in order).
 class SimSource final : public FrameSource {
  public:
   // channels: 1 (grey, the fastest) or 3 (RGB).
@@ -30,15 +34,30 @@ class SimSource final : public FrameSource {
   const SourceInfo& info() const noexcept override { return info_; }
   std::string read(std::size_t index, std::array<const dsp::FrameView*, 2>* views) override;
   const sim::Simulator& simulator() const noexcept { return *sim_; }
+  ~SimSource() override;
+  SimSource(const SimSource&) = delete;
+  SimSource& operator=(const SimSource&) = delete;
+
+  // The process-wide budget of kept frames: 1 GiB, the quick accuracy benchmark's calibration
+  // sets several times over (a grey pad frame is 75 KiB).
+  static constexpr std::size_t kFrameCacheBytes = std::size_t{1} << 30;
+  // Frames of this source read from the cache (tests).
+  std::size_t cache_hits() const noexcept { return cache_hits_; }
 
  private:
   SimSource() = default;
+  std::string simulate_to(std::size_t index);
+  void keep(std::size_t index);
   std::unique_ptr<sim::Simulator> sim_;
   SourceInfo info_;
   int channels_ = 1;
   std::array<std::vector<std::uint8_t>, 2> buf_;
   std::array<dsp::FrameView, 2> views_{};
   std::int64_t last_ = -1;
+  // Per frame index, both pads' rendered frames (empty: not kept).
+  std::vector<std::array<std::vector<std::uint8_t>, 2>> cache_;
+  std::size_t cached_bytes_ = 0;  // this source's share of the budget
+  std::size_t cache_hits_ = 0;
 };
 
 }  // namespace tacse3::tools
